@@ -1,0 +1,166 @@
+"""Command line: ``meshwear run | check | demo | info``.
+
+Exit codes: 0 ok, 2 bad input (one line on stderr naming the file and key),
+3 numerically invalid run (every output written so far stays valid).
+"""
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL = 0, 2, 3
+
+
+class InputError(Exception):
+    """Bad input found by the CLI itself (one line)."""
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(
+        prog="meshwear", description="Wear of rigid triangle-mesh bodies, as VTK time series.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("run", help="run a scene and write the ParaView series")
+    p.add_argument("scene", help="scene file (TOML, format 1)")
+    p.add_argument("-o", "--out", default=None, help="output folder (default: out/<scene name>)")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p = sub.add_parser("check", help="validate a scene and estimate its cost")
+    p.add_argument("scene")
+    p = sub.add_parser("demo", help="run the built-in demo scene")
+    p.add_argument("-o", "--out", default="out/demo")
+    p.add_argument("-q", "--quiet", action="store_true")
+    p = sub.add_parser("info", help="describe a mesh file")
+    p.add_argument("mesh")
+    p.add_argument("--units", default="m", help="units of the mesh file (m, mm, cm, um, in)")
+    args = parser.parse_args(argv)
+
+    import logging
+
+    logging.basicConfig(level=logging.WARNING, format="meshwear: %(message)s")
+    # heavy imports only once the arguments are known
+    from .geometry import MeshError
+    from .scene import SceneError
+
+    try:
+        if args.command == "run":
+            return _run(args.scene, args.out, args.quiet)
+        if args.command == "demo":
+            from importlib.resources import files
+
+            scene = files("meshwear") / "data" / "demo.toml"
+            return _run(str(scene), args.out, args.quiet)
+        if args.command == "check":
+            return _check(args.scene)
+        return _info(args.mesh, args.units)
+    except (SceneError, MeshError, InputError) as err:
+        print(f"meshwear: error: {err}", file=sys.stderr)
+        return EXIT_INPUT
+    except KeyboardInterrupt:
+        print("meshwear: interrupted; the outputs written so far are valid", file=sys.stderr)
+        return 130
+
+
+def _prepare(scene_path):
+    from .model import build_model, stable_time_step
+    from .scene import load_scene
+
+    scene = load_scene(scene_path)
+    model = build_model(scene)
+    limit, who = stable_time_step(model)
+    if scene.run.dt > limit:
+        raise InputError(
+            f"{scene.source}: run.dt: {scene.run.dt:.3g} s is above the stability limit of the "
+            f"contact on body {who!r}; the largest stable dt is {limit:.3g} s")
+    return scene, model, limit
+
+
+def _run(scene_path, out, quiet):
+    from .model import initial_state
+    from .output.recorder import RunRecorder, summary
+    from .simulate import NumericalError, Timer, run
+
+    scene, model, _ = _prepare(scene_path)
+    out_dir = Path(out) if out else Path("out") / Path(scene_path).stem
+    timer = Timer()
+    state = initial_state(model)
+    recorder = RunRecorder(out_dir, model)
+    progress = None if quiet or not sys.stderr.isatty() else _ProgressBar(model)
+    try:
+        run(model, state, observers=[recorder], progress=progress)
+    except NumericalError as err:
+        if progress:
+            progress.finish()
+        recorder.close(summary(model, state, timer.elapsed, "numerical_error", str(err)))
+        print(f"meshwear: run stopped: {err}", file=sys.stderr)
+        print(f"meshwear: outputs up to t = {state.time:.6g} s are in {out_dir}", file=sys.stderr)
+        return EXIT_NUMERICAL
+    if progress:
+        progress.finish()
+    recorder.close(summary(model, state, timer.elapsed))
+    if not quiet:
+        print(f"done in {timer.elapsed:.1f} s: {model.n_steps} steps, "
+              f"{len(model.frame_steps)} frames")
+        for body in model.bodies:
+            print(f"  ParaView series: {out_dir / (body.name + '.pvd')}")
+        for plane in model.plane_list:
+            print(f"  surface: {out_dir / (plane.name + '.pvd')}")
+        print(f"  history: {out_dir / 'history.csv'}, summary: {out_dir / 'summary.json'}")
+    return EXIT_OK
+
+
+def _check(scene_path):
+    from .model import initial_state
+    from .simulate import step
+
+    scene, model, limit = _prepare(scene_path)
+    print(f"scene {scene.source}: ok (format 1, mode {scene.run.mode})")
+    for b, config in zip(model.bodies, scene.bodies):
+        print(f"  body {b.name!r}: {len(b.tributary_area)} contact points, {len(b.faces)} faces, "
+              f"mass {b.mass:.6g} kg, motion {config.motion}")
+    for p in model.plane_list:
+        print(f"  plane {p.name!r}: point {p.point.tolist()}, normal {p.normal.tolist()}")
+    print(f"  dt {model.dt:.3g} s, largest stable dt {limit:.3g} s, {model.n_steps} steps, "
+          f"{len(model.frame_steps)} frames, {len(model.sample_steps)} history rows")
+    state = initial_state(model)
+    step(model, state)  # compile (or load the cached) kernels
+    trial = min(model.n_steps, 200)
+    start = time.perf_counter()
+    for _ in range(trial):
+        step(model, state)
+    per_step = (time.perf_counter() - start) / max(trial, 1)
+    points = sum(len(b.tributary_area) for b in model.bodies) * max(1, model.planes.shape[0])
+    print(f"  estimated run time {per_step * model.n_steps:.3g} s "
+          f"({per_step * 1e6:.3g} µs per step, {points / per_step:.3g} vertex-steps/s)")
+    return EXIT_OK
+
+
+def _info(mesh_path, units):
+    from .geometry import mesh_info
+
+    info = mesh_info(mesh_path, units)
+    for key, value in info.items():
+        print(f"{key}: {value}")
+    return EXIT_OK
+
+
+class _ProgressBar:
+    """One line on stderr, redrawn at every history sample."""
+
+    def __init__(self, model, width=30):
+        self.model, self.width, self.start = model, width, time.perf_counter()
+
+    def __call__(self, step, n_steps):
+        done = step / max(n_steps, 1)
+        elapsed = time.perf_counter() - self.start
+        eta = elapsed / done - elapsed if done > 0 else float("nan")
+        bar = "#" * int(done * self.width)
+        sys.stderr.write(f"\r[{bar:<{self.width}}] {100 * done:5.1f}%  t = {step * self.model.dt:.4g} s"
+                         f"  eta {eta:5.0f} s ")
+        sys.stderr.flush()
+
+    def finish(self):
+        sys.stderr.write("\n")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,561 @@
+"""Meshes in, plain arrays out: loading, units, cleaning, primitives, refinement,
+vertex areas, normals and mass properties.
+
+trimesh is used here for reading files and building primitives only; every
+function returns plain arrays, ``vertices : (n, 3) float64`` (C-contiguous) and
+``faces : (m, 3) int64`` with counter-clockwise (outward) winding.
+"""
+
+import logging
+from pathlib import Path
+
+import numpy as np
+
+log = logging.getLogger(__name__)
+
+#: metres per unit of a mesh file
+UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "in": 0.0254}
+
+#: vertices closer than this fraction of the bounding-box diagonal are merged
+MERGE_TOLERANCE = 1e-9
+#: a face is degenerate when twice its area is below this times its longest edge squared
+DEGENERATE_RATIO = 1e-12
+
+
+class MeshError(ValueError):
+    """Bad mesh input; ``str(err)`` is one line naming the file and what is wrong."""
+
+
+def _arrays(vertices, faces):
+    return (np.ascontiguousarray(vertices, dtype=np.float64),
+            np.ascontiguousarray(faces, dtype=np.int64).reshape(-1, 3))
+
+
+# ---------------------------------------------------------------- loading
+
+def load_mesh(path, units="m"):
+    """Read a triangle mesh file (STL, OBJ, PLY, OFF, GLB, ...) in metres, cleaned.
+
+    Parameters
+    ----------
+    path : str or Path
+    units : str
+        Units of the file, a key of :data:`UNITS`.
+
+    Returns
+    -------
+    vertices : (n, 3) float
+        Metres.
+    faces : (m, 3) int
+
+    Raises
+    ------
+    MeshError
+        Unknown units, unreadable file, no faces, non-finite vertices.
+    """
+    path = Path(path)
+    if not isinstance(units, str) or units not in UNITS:
+        raise MeshError(f"{path}: units {units!r}: expected one of {', '.join(UNITS)}")
+    scale = UNITS[units]
+    if not path.is_file():
+        raise MeshError(f"{path}: {'not a file' if path.exists() else 'mesh file not found'}")
+    import trimesh
+
+    try:
+        mesh = trimesh.load(str(path), force="mesh", process=False)
+    except Exception as err:  # trimesh raises anything from KeyError to struct.error
+        reason = str(err).splitlines()[0] if str(err) else type(err).__name__
+        raise MeshError(f"{path}: cannot read a mesh ({reason})") from None
+    vertices = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64)
+    faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
+    if faces.size == 0 or vertices.size == 0:
+        raise MeshError(f"{path}: no triangle faces found (empty, or not a mesh file)")
+    return clean(vertices * scale, faces, source=str(path))
+
+
+def clean(vertices, faces, source="<mesh>"):
+    """Merge duplicate vertices, drop degenerate and duplicate faces and unused vertices.
+
+    Duplicate vertices (STL seams) are merged within ``MERGE_TOLERANCE`` of the
+    bounding-box diagonal. A zero-area face whose three vertices are collinear
+    is removed by splitting the neighbour across its longest edge at its middle
+    vertex, so a closed mesh stays closed; other degenerate faces are dropped.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    source : str
+        Named in log lines and errors.
+
+    Returns
+    -------
+    vertices : (k, 3) float
+    faces : (l, 3) int
+    """
+    vertices, faces = _arrays(vertices, faces)
+    n0, m0 = len(vertices), len(faces)
+    if vertices.ndim != 2 or vertices.shape[1] != 3:
+        raise MeshError(f"{source}: vertices have shape {vertices.shape}, expected (n, 3)")
+    if not np.all(np.isfinite(vertices)):
+        bad = int((~np.isfinite(vertices).all(axis=1)).sum())
+        raise MeshError(f"{source}: {bad} vertex(es) have NaN or infinite coordinates")
+    if m0 and (faces.min() < 0 or faces.max() >= n0):
+        raise MeshError(f"{source}: faces refer to vertices that do not exist")
+    diagonal = float(np.linalg.norm(np.ptp(vertices, axis=0))) if n0 else 0.0
+    if m0 == 0 or not diagonal > 0.0:
+        raise MeshError(f"{source}: no faces with a non-zero extent")
+    vertices, faces = _merge_vertices(vertices, faces, MERGE_TOLERANCE * diagonal)
+    merged = n0 - len(vertices)
+
+    faces = faces[(faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2]) & (faces[:, 2] != faces[:, 0])]
+    collapsed = m0 - len(faces)
+    faces, slivers, split = _remove_slivers(vertices, faces)
+    degenerate = collapsed + slivers
+    if len(faces) == 0:
+        raise MeshError(f"{source}: every face is degenerate (zero area)")
+    _, first = np.unique(np.sort(faces, axis=1), axis=0, return_index=True)
+    duplicate = len(faces) - len(first)
+    faces = faces[np.sort(first)]
+
+    used = np.zeros(len(vertices), dtype=bool)
+    used[faces] = True
+    remap = np.cumsum(used) - 1
+    unused = int((~used).sum())
+    vertices, faces = _arrays(vertices[used], remap[faces])
+    if _is_closed(faces) and _signed_volume(vertices, faces) < 0.0:
+        # normals must point out of the body: contact and wear directions depend on it
+        log.warning("%s: faces were wound inwards (negative volume); flipped", source)
+        faces = np.ascontiguousarray(faces[:, ::-1])
+    if merged:
+        log.info("%s: merged %d duplicate vertices", source, merged)
+    if degenerate or duplicate or unused:
+        log.warning("%s: removed %d degenerate face(s) (%d neighbour(s) split to keep the surface closed), "
+                    "%d duplicate face(s), %d unused vertex(es)", source, degenerate, split, duplicate, unused)
+    return vertices, faces
+
+
+def _is_closed(faces):
+    """True if every edge has exactly two faces, traversing it in opposite directions."""
+    n = int(faces.max()) + 1
+    directed = (faces * n + np.roll(faces, -1, axis=1)).ravel()
+    _, count = np.unique(_edge_keys(faces, n), return_counts=True)
+    return bool(np.all(count == 2) and len(np.unique(directed)) == len(directed))
+
+
+def _signed_volume(vertices, faces):
+    tri = vertices[faces] - vertices.mean(axis=0)
+    return float(np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0)
+
+
+def _merge_vertices(vertices, faces, tolerance):
+    """Vertices closer than ``tolerance`` become one (the first of each cluster)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(vertices).query_pairs(tolerance, output_type="ndarray")
+    if len(pairs) == 0:
+        return vertices, faces
+    n = len(vertices)
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    _, first, inverse = np.unique(label, return_index=True, return_inverse=True)
+    order = np.argsort(first)            # keep the vertices' original order
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    return _arrays(vertices[first[order]], rank[inverse][faces])
+
+
+def _doubled_areas(vertices, faces):
+    tri = vertices[faces]
+    return np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+
+
+def _edge_lengths(vertices, faces):
+    """(m, 3) float: length of edge k = (faces[:, k], faces[:, k+1])."""
+    tri = vertices[faces]
+    return np.linalg.norm(np.roll(tri, -1, axis=1) - tri, axis=2)
+
+
+def _slivers(vertices, faces):
+    """(m,) bool: faces whose height is below DEGENERATE_RATIO of their longest edge."""
+    lengths = _edge_lengths(vertices, faces)
+    return _doubled_areas(vertices, faces) <= DEGENERATE_RATIO * lengths.max(axis=1) ** 2
+
+
+def _remove_slivers(vertices, faces, passes=16):
+    """Remove zero-area faces; returns (faces, slivers removed, neighbours split)."""
+    m0, split = len(faces), 0
+    n = len(vertices)
+    for _ in range(passes):
+        sliver = _slivers(vertices, faces)
+        if not sliver.any():
+            break
+        # the sliver's middle vertex c is opposite its longest edge (a, b); the
+        # neighbour across (a, b) holds the directed edge (b, a)
+        idx = np.flatnonzero(sliver)
+        k = _edge_lengths(vertices, faces[idx]).argmax(axis=1)
+        a, b, c = faces[idx, k], faces[idx, (k + 1) % 3], faces[idx, (k + 2) % 3]
+        key = (faces * n + np.roll(faces, -1, axis=1)).ravel()
+        order = np.argsort(key)
+        pos = np.minimum(np.searchsorted(key, b * n + a, sorter=order), len(key) - 1)
+        neighbour = order[pos] // 3
+        ok = (key[order[pos]] == b * n + a) & ~sliver[neighbour]
+        _, first = np.unique(neighbour[ok], return_index=True)   # one sliver per neighbour per pass
+        pick = np.flatnonzero(ok)[first]
+        if len(pick) == 0:
+            break
+        nb = neighbour[pick]
+        d = faces[nb].sum(axis=1) - a[pick] - b[pick]            # the neighbour's third vertex
+        children = np.concatenate([np.stack([b[pick], c[pick], d], axis=1),
+                                   np.stack([c[pick], a[pick], d], axis=1)])
+        keep = np.ones(len(faces), bool)
+        keep[idx[pick]] = False
+        keep[nb] = False
+        faces = np.concatenate([faces[keep], children])
+        split += len(pick)
+    faces = np.ascontiguousarray(faces[~_slivers(vertices, faces)])
+    return faces, m0 - len(faces), split
+
+
+# ------------------------------------------------------------- primitives
+
+def primitive(kind, *, size=None, radius=None, subdivisions=3, height=None, sections=32):
+    """A closed primitive centred at the origin.
+
+    Parameters
+    ----------
+    kind : {"box", "sphere", "cylinder"}
+    size : float or (3,) float
+        Box edge lengths (m).
+    radius : float
+        Sphere or cylinder radius (m).
+    subdivisions : int
+        Icosphere subdivisions (20·4^s faces).
+    height : float
+        Cylinder height (m), along z.
+    sections : int
+        Cylinder facets around the axis.
+    """
+    import trimesh
+
+    def positive(name, value):
+        if value is None or not np.all(np.asarray(value, float) > 0):
+            raise ValueError(f"{kind}: {name} must be given and positive, got {value!r}")
+
+    if kind == "box":
+        positive("size", size)
+        mesh = trimesh.creation.box(extents=np.broadcast_to(np.asarray(size, float), 3))
+    elif kind == "sphere":
+        positive("radius", radius)
+        mesh = trimesh.creation.icosphere(subdivisions=int(subdivisions), radius=float(radius))
+    elif kind == "cylinder":
+        positive("radius", radius)
+        positive("height", height)
+        mesh = trimesh.creation.cylinder(radius=float(radius), height=float(height), sections=int(sections))
+    else:
+        raise ValueError(f"primitive {kind!r}: expected one of box, sphere, cylinder")
+    return _arrays(mesh.vertices, mesh.faces)
+
+
+# -------------------------------------------------------------- refinement
+
+def refine(vertices, faces, resolution, face_mask=None, max_faces=5_000_000):
+    """Split triangles until every edge of the selected faces is <= ``resolution``.
+
+    Conforming longest-edge bisection (Rivara): a face that needs refining has
+    its longest edge split; a face that shares a split edge has its own longest
+    edge split too (closure), then each face is cut along its split edges. No
+    T-junctions are left, so a closed mesh stays closed. After each pass,
+    Delaunay edge flips between coplanar selected faces keep the triangles well
+    shaped, so a long thin CAD triangle costs about what a well-shaped face of
+    the same area does. The surface itself never changes.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    resolution : float
+        Largest edge length allowed on selected faces (m).
+    face_mask : (m,) bool, optional
+        Faces to refine (default all). Children of selected faces stay selected;
+        unselected faces are split only where needed to stay conforming.
+    max_faces : int
+        Refuse (MeshError) rather than build a larger mesh.
+
+    Returns
+    -------
+    vertices : (k, 3) float
+    faces : (l, 3) int
+    """
+    V, F = _arrays(vertices, faces)
+    if not resolution > 0:
+        raise ValueError(f"resolution must be positive, got {resolution!r}")
+    mask = np.ones(len(F), bool) if face_mask is None else np.asarray(face_mask, bool).copy()
+    if mask.shape != (len(F),):
+        raise ValueError(f"face_mask has shape {mask.shape}, expected ({len(F)},)")
+    while True:
+        lengths = _edge_lengths(V, F)
+        need = mask & (lengths.max(axis=1) > resolution)
+        if not need.any():
+            return _arrays(V, F)
+        longest = lengths.argmax(axis=1)
+        edges, eid = np.unique(_edge_keys(F, len(V)), return_inverse=True)
+        eid = eid.reshape(-1, 3)
+        rows = np.arange(len(F))
+        marked = np.zeros(len(edges), bool)
+        marked[eid[need, longest[need]]] = True
+        while True:  # closure: a face with any split edge has its longest edge split too
+            bad = marked[eid].any(axis=1) & ~marked[eid[rows, longest]]
+            if not bad.any():
+                break
+            marked[eid[bad, longest[bad]]] = True
+        midpoint = np.full(len(edges), -1, np.int64)
+        midpoint[marked] = len(V) + np.arange(marked.sum())
+        ends = np.stack(np.divmod(edges[marked], len(V)), axis=1)
+        V = np.concatenate([V, 0.5 * (V[ends[:, 0]] + V[ends[:, 1]])])
+        F, mask, first_new = _bisect(F, mask, eid, midpoint, marked, longest)
+        active = np.zeros(len(F), bool)
+        active[first_new:] = True
+        F = _flip_coplanar(V, F, mask, active)
+        if len(F) > max_faces:
+            raise MeshError(f"refining to resolution {resolution:g} m needs more than {max_faces} faces")
+
+
+def _edge_keys(F, n):
+    """(m·3,) int: undirected key min·n + max of edge k = (F[:, k], F[:, k+1])."""
+    G = np.roll(F, -1, axis=1)
+    return (np.minimum(F, G) * n + np.maximum(F, G)).ravel()
+
+
+def _bisect(F, mask, eid, midpoint, marked, longest):
+    """Cut every face along its marked edges (the longest one first).
+
+    Returns the new faces, their mask and the index of the first new face
+    (uncut faces come first, unchanged).
+    """
+    rows = np.arange(len(F))
+    cut = marked[eid[rows, longest]]
+    k = longest[cut]
+    f, e = F[cut], eid[cut]
+    r = np.arange(len(f))
+    a, b, c = f[r, k], f[r, (k + 1) % 3], f[r, (k + 2) % 3]
+    m0 = midpoint[e[r, k]]
+    m1, m2 = midpoint[e[r, (k + 1) % 3]], midpoint[e[r, (k + 2) % 3]]
+    s1, s2 = m1 >= 0, m2 >= 0
+    children = [
+        np.stack([a, m0, c], axis=1)[~s2],            # (a, m0, c) kept whole
+        np.stack([m0, c, m2], axis=1)[s2],            # ... or cut on (c, a)
+        np.stack([m0, m2, a], axis=1)[s2],
+        np.stack([m0, b, c], axis=1)[~s1],            # (m0, b, c) kept whole
+        np.stack([m0, b, m1], axis=1)[s1],            # ... or cut on (b, c)
+        np.stack([m0, m1, c], axis=1)[s1],
+    ]
+    sel = mask[cut]
+    child_mask = [sel[~s2], sel[s2], sel[s2], sel[~s1], sel[s1], sel[s1]]
+    return (np.concatenate([F[~cut]] + children),
+            np.concatenate([mask[~cut]] + child_mask), int((~cut).sum()))
+
+
+def _flip_coplanar(V, F, mask, active, rounds=100):
+    """Delaunay edge flips between coplanar selected faces (the surface is unchanged).
+
+    Bisection alone keeps a thin triangle's children thin; flipping the shared
+    edge of two coplanar triangles whose opposite angles sum past pi restores
+    well-shaped triangles. Only edges of ``active`` (m,) bool faces are tested,
+    then those of the faces just flipped.
+    """
+    F = F.copy()
+    n = len(V)
+    for _ in range(rounds):
+        key = (F * n + np.roll(F, -1, axis=1)).ravel()            # directed edges
+        src = np.flatnonzero(np.repeat(active, 3) & (key // n < key % n))
+        order = np.argsort(key)
+        u, v = key[src] // n, key[src] % n
+        pos = np.minimum(np.searchsorted(key, v * n + u, sorter=order), len(key) - 1)
+        twin = order[pos]
+        ok = key[twin] == v * n + u
+        src, twin = src[ok], twin[ok]
+        # an edge (u < v) of an inactive face next to an active one: seen from the active side
+        back = np.flatnonzero(np.repeat(active, 3) & (key // n > key % n))
+        pos = np.minimum(np.searchsorted(key, (key[back] % n) * n + key[back] // n, sorter=order), len(key) - 1)
+        ok = (key[order[pos]] == (key[back] % n) * n + key[back] // n) & ~active[order[pos] // 3]
+        src, twin = np.concatenate([src, order[pos][ok]]), np.concatenate([twin, back[ok]])
+        f1, k1, f2, k2 = src // 3, src % 3, twin // 3, twin % 3
+        ok = mask[f1] & mask[f2] & (f1 != f2)
+        f1, k1, f2, k2 = f1[ok], k1[ok], f2[ok], k2[ok]
+        a, b = F[f1, k1], F[f1, (k1 + 1) % 3]
+        c, d = F[f1, (k1 + 2) % 3], F[f2, (k2 + 2) % 3]
+        t1, t2 = V[F[f1]], V[F[f2]]
+        n1 = np.cross(t1[:, 1] - t1[:, 0], t1[:, 2] - t1[:, 0])
+        n2 = np.cross(t2[:, 1] - t2[:, 0], t2[:, 2] - t2[:, 0])
+        coplanar = np.einsum("ij,ij->i", n1, n2) > (1.0 - 1e-12) * np.linalg.norm(n1, axis=1) * np.linalg.norm(n2, axis=1)
+        ca, cb, da, db = V[a] - V[c], V[b] - V[c], V[a] - V[d], V[b] - V[d]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cot_c = np.einsum("ij,ij->i", ca, cb) / np.linalg.norm(np.cross(ca, cb), axis=1)
+            cot_d = np.einsum("ij,ij->i", da, db) / np.linalg.norm(np.cross(da, db), axis=1)
+            badness = cot_c + cot_d                              # < 0: not Delaunay
+        flip = coplanar & (badness < -1e-9)
+        if flip.any():  # the new edge (c, d) must not exist already
+            flip &= ~np.isin(np.minimum(c, d) * n + np.maximum(c, d), _edge_keys(F, n))
+        if not flip.any():
+            return F
+        cand = np.flatnonzero(flip)[np.argsort(badness[flip])]  # worst first
+        idx = np.arange(len(cand))
+        owner = np.full(len(F), len(cand))
+        np.minimum.at(owner, f1[cand], idx)
+        np.minimum.at(owner, f2[cand], idx)
+        cand = cand[(owner[f1[cand]] == idx) & (owner[f2[cand]] == idx)]   # each face in one flip
+        F[f1[cand]] = np.stack([c[cand], a[cand], d[cand]], axis=1)
+        F[f2[cand]] = np.stack([d[cand], b[cand], c[cand]], axis=1)
+        active = np.zeros(len(F), bool)
+        active[f1[cand]] = True
+        active[f2[cand]] = True
+    return F
+
+
+# ------------------------------------------------- areas, normals, checks
+
+def tributary_areas(vertices, faces):
+    """(n,) float: each vertex's barycentric share (m²), a third of each adjacent face's area."""
+    V, F = _arrays(vertices, faces)
+    third = _doubled_areas(V, F) / 6.0
+    return np.bincount(F.ravel(), weights=np.repeat(third, 3), minlength=len(V))
+
+
+def face_normals(vertices, faces):
+    """(m, 3) float: unit outward face normals; zero-area faces give zeros."""
+    V, F = _arrays(vertices, faces)
+    tri = V[F]
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    norm = np.linalg.norm(cross, axis=1, keepdims=True)
+    return np.divide(cross, norm, out=np.zeros_like(cross), where=norm > 0.0)
+
+
+def vertex_normals(vertices, faces):
+    """(n, 3) float: unit outward vertex normals, area-weighted over adjacent faces."""
+    V, F = _arrays(vertices, faces)
+    tri = V[F]
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])   # 2 · area · normal
+    summed = np.zeros_like(V)
+    for k in range(3):
+        np.add.at(summed, F[:, k], cross)
+    norm = np.linalg.norm(summed, axis=1, keepdims=True)
+    return np.ascontiguousarray(np.divide(summed, norm, out=np.zeros_like(summed), where=norm > 0.0))
+
+
+def inverted_faces(reference_normals, vertices, faces, reference_areas=None):
+    """(k,) int: faces whose current normal flipped or collapsed against the reference.
+
+    A face is flagged when its area projected on its reference normal is
+    negative (flipped) or below 1e-12 of its reference area (collapsed). Without
+    ``reference_areas`` the collapse test is relative to the face's longest
+    edge squared. Faces with a zero reference normal are never flagged.
+
+    Parameters
+    ----------
+    reference_normals : (m, 3) float
+        Unit normals of the unworn faces (:func:`face_normals`).
+    vertices : (n, 3) float
+        Current (worn) vertices, same frame as the reference.
+    faces : (m, 3) int
+    reference_areas : (m,) float, optional
+    """
+    V, F = _arrays(vertices, faces)
+    ref = np.asarray(reference_normals, np.float64)
+    tri = V[F]
+    projected = 0.5 * np.einsum("ij,ij->i", np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), ref)
+    if reference_areas is not None:
+        scale = np.asarray(reference_areas, np.float64)
+    else:
+        scale = _edge_lengths(V, F).max(axis=1) ** 2
+    valid = np.einsum("ij,ij->i", ref, ref) > 0.0
+    return np.flatnonzero(valid & (projected <= 1e-12 * scale))
+
+
+# ---------------------------------------------------------- mass, info
+
+def mass_properties(vertices, faces, density=None, mass=None, source="mesh"):
+    """Mass, centre of mass and inertia of the solid a closed mesh encloses.
+
+    Exact polyhedral integrals (trimesh), evaluated about the bounding-box
+    centre to keep precision for meshes far from their origin. A closed mesh
+    with inverted winding (negative volume) is accepted as if flipped.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    density : float, optional
+        kg/m³.
+    mass : float, optional
+        kg, instead of density (the inertia is scaled to it). Neither: density 1.
+    source : str
+        Named in errors.
+
+    Returns
+    -------
+    mass : float
+        kg.
+    center_of_mass : (3,) float
+        In the mesh frame (m).
+    inertia : (3, 3) float
+        About the centre of mass, mesh axes (kg·m²).
+    """
+    import trimesh
+
+    if density is not None and mass is not None:
+        raise ValueError("give density or mass, not both")
+    for name, value in (("density", density), ("mass", mass)):
+        if value is not None and not (np.isfinite(value) and value > 0):
+            raise ValueError(f"{name} must be positive, got {value!r}")
+    V, F = _arrays(vertices, faces)
+    mesh = trimesh.Trimesh(V, F, process=False)
+    if not mesh.is_watertight:
+        raise MeshError(f"{source}: open mesh ({_boundary_edges(F)} boundary edges): "
+                        "give the body a closed mesh")
+    if not mesh.is_winding_consistent:
+        raise MeshError(f"{source}: inconsistent face winding: give the body a consistently oriented closed mesh")
+    shift = 0.5 * (V.min(axis=0) + V.max(axis=0))
+    props = trimesh.triangles.mass_properties(V[F] - shift, density=1.0)
+    volume = float(props.volume)
+    if volume < 0.0:
+        log.warning("%s: faces wound inwards (negative volume); using the flipped mesh", source)
+        props = trimesh.triangles.mass_properties(V[F[:, ::-1]] - shift, density=1.0)
+        volume = float(props.volume)
+    if not volume > 0.0:
+        raise MeshError(f"{source}: the mesh encloses no volume")
+    rho = (mass / volume) if mass is not None else (1.0 if density is None else float(density))
+    inertia = np.ascontiguousarray(props.inertia * rho)
+    return rho * volume, np.asarray(props.center_mass, np.float64) + shift, inertia
+
+
+def _boundary_edges(F):
+    _, count = np.unique(_edge_keys(F, int(F.max()) + 1), return_counts=True)
+    return int((count != 2).sum())
+
+
+def mesh_info(path, units="m"):
+    """Summary of a mesh file after loading and cleaning (plain Python values, SI).
+
+    Returns
+    -------
+    dict
+        ``vertices``, ``faces``, ``watertight``, ``extents`` [3], ``area`` (m²),
+        ``volume`` (m³, None if open), ``bounds`` [[min], [max]].
+    """
+    import trimesh
+
+    V, F = load_mesh(path, units)
+    mesh = trimesh.Trimesh(V, F, process=False)
+    watertight = bool(mesh.is_watertight and mesh.is_winding_consistent)
+    return {
+        "vertices": len(V),
+        "faces": len(F),
+        "watertight": watertight,
+        "extents": np.ptp(V, axis=0).tolist(),
+        "area": float(_doubled_areas(V, F).sum() / 2.0),
+        "volume": abs(float(mesh.volume)) if watertight else None,
+        "bounds": [V.min(axis=0).tolist(), V.max(axis=0).tolist()],
+    }

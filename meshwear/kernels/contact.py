@@ -1,0 +1,229 @@
+"""Point-plane contact, friction and wear of one body against analytic planes.
+
+One fused kernel does, for every vertex ``i`` of a worn body and every plane
+``s``, the phases of DESIGN.md §1 in order: penetration, normal force (eq. 1),
+the stick/slip state machine (eq. 2-4), dissipated energy, wear (eq. 5 and its
+variants) and the geometry update. Fusing keeps each vertex's data in registers
+for one pass; the phases stay readable as the small inline functions below.
+
+Array conventions (all C-contiguous float64 unless said otherwise):
+
+pose : (13,)
+    Rigid state of the body: centre of mass ``x`` (0:3, m, world), unit
+    quaternion ``q`` (3:7, w x y z, body -> world), velocity ``v`` of the centre
+    of mass (7:10, m/s, world), angular velocity ``omega`` (10:13, rad/s, world).
+planes : (P, 3, 3)
+    Per plane: a point on it (m), its unit normal ``n`` pointing into the worn
+    body, and its translational velocity (m/s).
+area : (n,)
+    Tributary area ``A_i`` of each vertex (m²).
+law : (13,)
+    ``f``, ``f0``, wear law code (:data:`ENERGY`, :data:`ENERGY_DENSITY`,
+    :data:`ARCHARD`), wear coefficient ``k``, time step ``dt`` (s), then the
+    contact coefficients as (per point, per area) pairs: normal stiffness,
+    normal damping, tangential stiffness, tangential damping. Point ``i`` gets
+    ``c_i = c_point + c_area A_i`` (N/m), and likewise ``d_i``, ``c_t,i``,
+    ``d_t,i``: one of each pair is zero (DESIGN.md §1, per point or Winkler).
+body_vertices : (n, 3)
+    Worn vertex positions in the body frame (m, relative to the centre of
+    mass); wear moves them in place.
+wear_direction : (n, 3) or (0, 3)
+    Inward unit vertex normals in the body frame when wear moves vertices
+    along them; an empty array moves vertices along the contact normal.
+contact_state : (P, n) int8
+    0 no contact, 1 stick, 2 slip; updated in place.
+tangential : (P, n, 4, 3)
+    Per contact pair: stick anchor ``r0`` (m, world, on the plane), friction
+    force ``F0`` when stick began (N), current friction force ``F`` (N) and the
+    last non-zero slip velocity (m/s); updated in place.
+normal_force : (P, n)
+    ``N`` (N), written.
+friction_work, wear_depth : (n,)
+    Cumulative dissipated energy ``E`` (J) and wear depth ``w`` (m); increased.
+wrench : (6,)
+    Total contact force (N, world) and torque about the centre of mass (N·m),
+    written.
+"""
+
+import types
+
+import numpy as np
+from numba import njit, prange
+
+NO_CONTACT, STICK, SLIP = 0, 1, 2
+ENERGY, ENERGY_DENSITY, ARCHARD = 0, 1, 2
+WEAR_LAWS = {"energy": ENERGY, "energy_density": ENERGY_DENSITY, "archard": ARCHARD}
+
+# Pairs with at least this many vertex-plane pairs use the threaded kernel;
+# below it thread start-up costs more than the work.
+PARALLEL_THRESHOLD = 4096
+
+
+@njit(cache=True, inline="always")
+def rotation_entries(q):
+    """Rotation matrix of unit quaternion ``q`` (w, x, y, z), row by row, as 9 floats."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    return (1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y),
+            2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x),
+            2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y))
+
+
+def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
+                   contact_state, tangential, normal_force,
+                   friction_work, wear_depth, wrench):
+    n_points = body_vertices.shape[0]
+    n_planes = planes.shape[0]
+    f, f0, wear_law, k, dt = law[0], law[1], int(law[2]), law[3], law[4]
+    c0, c1, d0, d1 = law[5], law[6], law[7], law[8]
+    ct0, ct1, dt0, dt1 = law[9], law[10], law[11], law[12]
+    along_vertex_normal = wear_direction.shape[0] == n_points
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
+    fx = fy = fz = tx = ty = tz = 0.0
+    for i in prange(n_points):
+        a = area[i]
+        c, d, ct, dtan = c0 + c1 * a, d0 + d1 * a, ct0 + ct1 * a, dt0 + dt1 * a
+        bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
+        # world offset from the centre of mass, position and velocity of point A
+        rx = r00 * bx + r01 * by + r02 * bz
+        ry = r10 * bx + r11 * by + r12 * bz
+        rz = r20 * bx + r21 * by + r22 * bz
+        px, py, pz = pose[0] + rx, pose[1] + ry, pose[2] + rz
+        ux = pose[7] + pose[11] * rz - pose[12] * ry
+        uy = pose[8] + pose[12] * rx - pose[10] * rz
+        uz = pose[9] + pose[10] * ry - pose[11] * rx
+        for s in range(n_planes):
+            nx, ny, nz = planes[s, 1, 0], planes[s, 1, 1], planes[s, 1, 2]
+            # Delta = (x - p) . n, negative in penetration
+            delta = ((px - planes[s, 0, 0]) * nx + (py - planes[s, 0, 1]) * ny
+                     + (pz - planes[s, 0, 2]) * nz)
+            if delta >= 0.0:
+                contact_state[s, i] = NO_CONTACT
+                normal_force[s, i] = 0.0
+                for j in range(3):
+                    tangential[s, i, 2, j] = 0.0
+                continue
+            # velocity of A relative to the plane: normal rate and slip velocity
+            gx, gy, gz = ux - planes[s, 2, 0], uy - planes[s, 2, 1], uz - planes[s, 2, 2]
+            rate = gx * nx + gy * ny + gz * nz
+            sx, sy, sz = gx - rate * nx, gy - rate * ny, gz - rate * nz
+            # eq. 1: spring-damper normal force, no adhesion
+            load = -(c * delta + d * rate)
+            if load < 0.0:
+                load = 0.0
+            normal_force[s, i] = load
+            # point of the plane under A
+            ax, ay, az = px - delta * nx, py - delta * ny, pz - delta * nz
+            state = contact_state[s, i]
+            if state == NO_CONTACT:
+                # a new contact starts in stick with F0 = 0 at its position
+                state = STICK
+                tangential[s, i, 0, 0], tangential[s, i, 0, 1], tangential[s, i, 0, 2] = ax, ay, az
+                tangential[s, i, 1, 0] = tangential[s, i, 1, 1] = tangential[s, i, 1, 2] = 0.0
+                tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = sx, sy, sz
+            elif state == SLIP and sx * tangential[s, i, 3, 0] + sy * tangential[s, i, 3, 1] + sz * tangential[s, i, 3, 2] < 0.0:
+                # slip velocity reversed: stick from the turning point, one
+                # step back, with the force continuous (Jenkins element);
+                # anchoring here instead would leave |F| = f N at the limit
+                # and let any dip of N break the new stick at once
+                state = STICK
+                tangential[s, i, 0, 0] = ax - sx * dt
+                tangential[s, i, 0, 1] = ay - sy * dt
+                tangential[s, i, 0, 2] = az - sz * dt
+                tangential[s, i, 1, 0], tangential[s, i, 1, 1], tangential[s, i, 1, 2] = tangential[s, i, 2, 0], tangential[s, i, 2, 1], tangential[s, i, 2, 2]
+            speed = np.sqrt(sx * sx + sy * sy + sz * sz)
+            energy = 0.0
+            if state == STICK:
+                # eq. 2, stick: F = F0 - c_t (r - r0) - d_t v, r - r0 in the plane
+                ex, ey, ez = ax - tangential[s, i, 0, 0], ay - tangential[s, i, 0, 1], az - tangential[s, i, 0, 2]
+                en = ex * nx + ey * ny + ez * nz
+                ex, ey, ez = ex - en * nx, ey - en * ny, ez - en * nz
+                Fx = tangential[s, i, 1, 0] - ct * ex - dtan * sx
+                Fy = tangential[s, i, 1, 1] - ct * ey - dtan * sy
+                Fz = tangential[s, i, 1, 2] - ct * ez - dtan * sz
+                Fn = Fx * nx + Fy * ny + Fz * nz
+                Fx, Fy, Fz = Fx - Fn * nx, Fy - Fn * ny, Fz - Fn * nz
+                magnitude = np.sqrt(Fx * Fx + Fy * Fy + Fz * Fz)
+                if magnitude > f0 * load:
+                    # eq. 4: static limit exceeded, slip in the direction the
+                    # spring was dragged (or of the slip velocity if any)
+                    state = SLIP
+                    if speed == 0.0 and magnitude > 0.0:
+                        tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = -Fx, -Fy, -Fz
+                else:
+                    energy = dtan * speed * speed * dt
+            if state == SLIP:
+                if speed > 0.0:
+                    tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = sx, sy, sz
+                # eq. 3: Coulomb slip force against the (last) slip direction
+                lx, ly, lz = tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2]
+                ll = np.sqrt(lx * lx + ly * ly + lz * lz)
+                if ll > 0.0:
+                    scale = -f * load / ll
+                    Fx, Fy, Fz = scale * lx, scale * ly, scale * lz
+                else:
+                    Fx = Fy = Fz = 0.0
+                energy = f * load * speed * dt
+            elif speed > 0.0:
+                tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = sx, sy, sz
+            contact_state[s, i] = state
+            tangential[s, i, 2, 0], tangential[s, i, 2, 1], tangential[s, i, 2, 2] = Fx, Fy, Fz
+            # eq. 5 and variants: wear depth increment
+            if wear_law == ENERGY:
+                dw = k * energy
+            elif wear_law == ENERGY_DENSITY:
+                dw = k * energy / a
+            elif state == SLIP:
+                dw = k * load / a * speed * dt
+            else:
+                dw = 0.0
+            friction_work[i] += energy
+            wear_depth[i] += dw
+            if dw > 0.0:
+                # geometry update: into the body along +n, in the body frame
+                if along_vertex_normal:
+                    mx, my, mz = wear_direction[i, 0], wear_direction[i, 1], wear_direction[i, 2]
+                else:
+                    mx = r00 * nx + r10 * ny + r20 * nz
+                    my = r01 * nx + r11 * ny + r21 * nz
+                    mz = r02 * nx + r12 * ny + r22 * nz
+                body_vertices[i, 0] += dw * mx
+                body_vertices[i, 1] += dw * my
+                body_vertices[i, 2] += dw * mz
+            # force on the body from this contact, and its moment about the centre
+            qx, qy, qz = load * nx + Fx, load * ny + Fy, load * nz + Fz
+            fx += qx
+            fy += qy
+            fz += qz
+            tx += ry * qz - rz * qy
+            ty += rz * qx - rx * qz
+            tz += rx * qy - ry * qx
+    wrench[0], wrench[1], wrench[2] = fx, fy, fz
+    wrench[3], wrench[4], wrench[5] = tx, ty, tz
+
+
+def _named_copy(fn, name):
+    """The same function under another name: numba's on-disk cache is keyed by
+    the qualified name, so the serial and threaded builds need distinct ones."""
+    copy = types.FunctionType(fn.__code__, fn.__globals__, name, fn.__defaults__, fn.__closure__)
+    copy.__qualname__ = name
+    return copy
+
+
+plane_contact_serial = njit(cache=True)(_named_copy(_plane_contact, "plane_contact_serial"))
+plane_contact_parallel = njit(cache=True, parallel=True)(
+    _named_copy(_plane_contact, "plane_contact_parallel"))
+
+
+def plane_contact(body_vertices, pose, planes, area, law, wear_direction,
+                  contact_state, tangential, normal_force,
+                  friction_work, wear_depth, wrench):
+    """Contact, friction and wear of every vertex against every plane, one step.
+
+    See the module docstring for the arrays. Picks the threaded kernel when the
+    number of vertex-plane pairs makes threads worth starting.
+    """
+    kernel = (plane_contact_parallel
+              if body_vertices.shape[0] * planes.shape[0] >= PARALLEL_THRESHOLD
+              else plane_contact_serial)
+    kernel(body_vertices, pose, planes, area, law, wear_direction,
+           contact_state, tangential, normal_force, friction_work, wear_depth, wrench)

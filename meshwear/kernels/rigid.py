@@ -1,0 +1,114 @@
+"""Rigid-body kernels: one semi-implicit (symplectic) Euler step of Newton-Euler.
+
+``pose`` is the (13,) array of :mod:`meshwear.kernels.contact`: centre of mass,
+quaternion (w, x, y, z), velocity, angular velocity (world frame).
+"""
+
+import numpy as np
+from numba import njit
+
+from .contact import rotation_entries
+
+
+@njit(cache=True, inline="always")
+def _rotate(r, x, y, z):
+    """R (x, y, z) with R given row by row as 9 floats."""
+    return (r[0] * x + r[1] * y + r[2] * z,
+            r[3] * x + r[4] * y + r[5] * z,
+            r[6] * x + r[7] * y + r[8] * z)
+
+
+@njit(cache=True, inline="always")
+def _rotate_back(r, x, y, z):
+    """R^T (x, y, z)."""
+    return (r[0] * x + r[3] * y + r[6] * z,
+            r[1] * x + r[4] * y + r[7] * z,
+            r[2] * x + r[5] * y + r[8] * z)
+
+
+@njit(cache=True, inline="always")
+def _mul(m, x, y, z):
+    """M (x, y, z) for a (3, 3) array M."""
+    return (m[0, 0] * x + m[0, 1] * y + m[0, 2] * z,
+            m[1, 0] * x + m[1, 1] * y + m[1, 2] * z,
+            m[2, 0] * x + m[2, 1] * y + m[2, 2] * z)
+
+
+@njit(cache=True)
+def free_step(pose, wrench, inverse_mass, inertia_body, inverse_inertia_body,
+              acceleration, dt):
+    """Advance a free body by one step, in place.
+
+    Velocities first (from the forces at the current pose), then the pose with
+    the new velocities: the symplectic Euler step. The angular momentum
+    ``L = R I R^T omega`` takes the torque; the orientation turns with the
+    ``omega`` that ``L`` gives at the old orientation, and the stored ``omega``
+    is the one ``L`` gives at the new orientation, so a torque-free body keeps
+    ``L`` exactly.
+
+    Parameters
+    ----------
+    pose : (13,) float
+        Rigid state, updated.
+    wrench : (6,) float
+        Contact force (N) and torque about the centre of mass (N·m), world.
+    inverse_mass : float
+        1/m (1/kg).
+    inertia_body, inverse_inertia_body : (3, 3) float
+        Inertia tensor about the centre of mass in the body frame (kg·m²) and
+        its inverse.
+    acceleration : (3,) float
+        Gravity plus the constant applied force over the mass (m/s²).
+    dt : float
+        Time step (s).
+    """
+    for j in range(3):
+        pose[7 + j] += dt * (wrench[j] * inverse_mass + acceleration[j])
+    r = rotation_entries(pose[3:7])
+    bx, by, bz = _rotate_back(r, pose[10], pose[11], pose[12])
+    bx, by, bz = _mul(inertia_body, bx, by, bz)
+    lx, ly, lz = _rotate(r, bx, by, bz)
+    lx, ly, lz = lx + dt * wrench[3], ly + dt * wrench[4], lz + dt * wrench[5]
+    bx, by, bz = _rotate_back(r, lx, ly, lz)
+    bx, by, bz = _mul(inverse_inertia_body, bx, by, bz)
+    ox, oy, oz = _rotate(r, bx, by, bz)
+    for j in range(3):
+        pose[j] += dt * pose[7 + j]
+    # q <- exp(omega dt / 2) q, renormalised
+    rate = np.sqrt(ox * ox + oy * oy + oz * oz)
+    if rate > 0.0:
+        half = 0.5 * rate * dt
+        sw = np.sin(half) / rate
+        dw, dx, dy, dz = np.cos(half), sw * ox, sw * oy, sw * oz
+        w, x, y, z = pose[3], pose[4], pose[5], pose[6]
+        nw = dw * w - dx * x - dy * y - dz * z
+        nx = dw * x + dx * w + dy * z - dz * y
+        ny = dw * y - dx * z + dy * w + dz * x
+        nz = dw * z + dx * y - dy * x + dz * w
+        norm = np.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
+        pose[3], pose[4], pose[5], pose[6] = nw / norm, nx / norm, ny / norm, nz / norm
+    # omega consistent with L at the new orientation
+    r = rotation_entries(pose[3:7])
+    bx, by, bz = _rotate_back(r, lx, ly, lz)
+    bx, by, bz = _mul(inverse_inertia_body, bx, by, bz)
+    pose[10], pose[11], pose[12] = _rotate(r, bx, by, bz)
+
+
+@njit(cache=True)
+def axis_step(pose, wrench, inverse_mass, acceleration, axis, dt):
+    """Advance the free translation of a guided body along ``axis`` by one step.
+
+    Only the component of ``pose``'s velocity along the unit ``axis`` changes;
+    the caller sets the other components from the path.
+
+    Returns
+    -------
+    float
+        The new velocity along ``axis`` (m/s), from the forces at the current
+        pose (the velocity half of the symplectic step).
+    """
+    a = 0.0
+    for j in range(3):
+        a += (wrench[j] * inverse_mass + acceleration[j]) * axis[j]
+    rate = pose[7] * axis[0] + pose[8] * axis[1] + pose[9] * axis[2] + dt * a
+    return rate

@@ -1,0 +1,334 @@
+"""Model (frozen: what a scene is) and State (what changes while it runs).
+
+:func:`build_model` turns a validated :class:`meshwear.scene.Scene` into plain
+arrays once; :func:`initial_state` allocates every array a run writes into, so
+a step allocates nothing. Kernels see only these arrays.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import geometry
+from .kernels.contact import WEAR_LAWS, rotation_entries
+from .motion import FixedMotion, FreeMotion, GuidedMotion, Path, PrescribedMotion
+from .scene import SceneError
+
+#: fraction of the estimated stability limit accepted as the largest stable dt
+STABILITY_MARGIN = 0.9
+
+
+@dataclass(frozen=True, eq=False)
+class BodyModel:
+    """One worn body, in its body frame (origin at the centre of mass, axes of
+    the mesh file).
+
+    Attributes
+    ----------
+    name : str
+    faces : (m, 3) int64
+    reference_vertices : (n, 3) float
+        Unworn vertices, body frame (m).
+    tributary_area : (n,) float
+        Barycentric vertex areas of the reference mesh (m²).
+    wear_direction : (n, 3) or (0, 3) float
+        Inward vertex normals when wear moves along them, else empty.
+    reference_face_normals : (m, 3) float
+    mass : float
+        kg (nan for fixed or prescribed bodies whose mesh is open).
+    inertia : (3, 3) float
+        About the centre of mass, body frame (kg·m²).
+    origin : (3,) float
+        The mesh file's origin in the body frame (m): history's x, y, z.
+    initial_pose : (13,) float
+    motion : FreeMotion | GuidedMotion | PrescribedMotion | FixedMotion
+    period : float or None
+        Cycle length of the body's path (s).
+    """
+
+    name: str
+    faces: np.ndarray
+    reference_vertices: np.ndarray
+    tributary_area: np.ndarray
+    wear_direction: np.ndarray
+    reference_face_normals: np.ndarray
+    mass: float
+    inertia: np.ndarray
+    origin: np.ndarray
+    initial_pose: np.ndarray
+    motion: object
+    period: float | None
+
+
+@dataclass(frozen=True, eq=False)
+class PlaneModel:
+    name: str
+    point: np.ndarray
+    normal: np.ndarray
+    size: float
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    """Everything about a run that does not change while it runs.
+
+    ``planes`` is the (P, 3, 3) array the contact kernel takes (point, normal,
+    velocity per plane); ``law`` its (13,) contact and wear law.
+    """
+
+    scene: object
+    bodies: tuple
+    plane_list: tuple
+    planes: np.ndarray
+    law: np.ndarray
+    dt: float
+    n_steps: int
+    sample_steps: np.ndarray
+    frame_steps: np.ndarray
+    period: float | None
+
+    @property
+    def duration(self):
+        return self.n_steps * self.dt
+
+
+@dataclass(eq=False)
+class BodyState:
+    """What changes for one body; every array is allocated once.
+
+    Attributes
+    ----------
+    pose : (13,) float
+        Centre of mass, quaternion, velocity, angular velocity (world).
+    vertices : (n, 3) float
+        Worn vertices in the body frame (m).
+    wear_depth, friction_work : (n,) float
+        ``w`` (m) and ``E`` (J) per vertex.
+    contact_state : (P, n) int8
+    tangential : (P, n, 4, 3) float
+        Stick anchor, stick-start force, friction force, last slip velocity.
+    normal_force : (P, n) float
+    wrench : (6,) float
+        Contact force and torque about the centre of mass in the last step.
+    """
+
+    pose: np.ndarray
+    vertices: np.ndarray
+    wear_depth: np.ndarray
+    friction_work: np.ndarray
+    contact_state: np.ndarray
+    tangential: np.ndarray
+    normal_force: np.ndarray
+    wrench: np.ndarray = field(default_factory=lambda: np.zeros(6))
+
+
+@dataclass(eq=False)
+class State:
+    time: float
+    step: int
+    bodies: list
+
+
+def build_model(scene):
+    """Build the :class:`Model` of a validated scene (meshes loaded here).
+
+    Raises
+    ------
+    SceneError, geometry.MeshError
+        For input the engine cannot use, naming the key.
+    """
+    planes = []
+    for j, s in enumerate(scene.surfaces):
+        if s.type != "plane":
+            raise SceneError(scene.source, f"surface[{j}].type",
+                             "mesh counter-surfaces are not supported by this version; use a plane")
+        planes.append(PlaneModel(s.name, np.asarray(s.point, float),
+                                 np.asarray(s.normal, float), s.size))
+    plane_array = np.zeros((len(planes), 3, 3))
+    for j, p in enumerate(planes):
+        plane_array[j, 0] = p.point
+        plane_array[j, 1] = p.normal
+
+    run = scene.run
+    n_steps = max(1, int(np.ceil(run.duration / run.dt - 1e-9)))
+    dt = run.duration / n_steps
+    bodies = tuple(_build_body(scene, j, b) for j, b in enumerate(scene.bodies))
+    c = scene.contact
+    tangential_stiffness = ((c.stiffness, c.stiffness_per_area)
+                            if c.tangential_stiffness is None and c.tangential_stiffness_per_area is None
+                            else (c.tangential_stiffness, c.tangential_stiffness_per_area))
+    tangential_damping = ((c.damping, c.damping_per_area)
+                          if c.tangential_damping is None and c.tangential_damping_per_area is None
+                          else (c.tangential_damping, c.tangential_damping_per_area))
+    law = np.array([c.friction, c.static_friction, WEAR_LAWS[scene.wear.law], scene.wear.coefficient,
+                    dt, *_pair(c.stiffness, c.stiffness_per_area),
+                    *_pair(c.damping, c.damping_per_area), *_pair(*tangential_stiffness),
+                    *_pair(*tangential_damping)])
+    periods = [b.period for b in bodies if b.period is not None]
+    period = scene.wear.period or (max(periods) if periods else None)
+    # a plane without a size is drawn 4 body extents wide
+    extent = max(float(np.ptp(b.reference_vertices, axis=0).max()) for b in bodies)
+    planes = tuple(p if p.size is not None else PlaneModel(p.name, p.point, p.normal, 4.0 * extent)
+                   for p in planes)
+    return Model(scene=scene, bodies=bodies, plane_list=planes, planes=plane_array, law=law,
+                 dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
+                 frame_steps=_even_steps(n_steps, run.frames), period=period)
+
+
+def _even_steps(n_steps, count):
+    """Step indices of ``count`` evenly spaced samples, first 0, last n_steps."""
+    if count <= 0:
+        return np.zeros(0, dtype=np.int64)
+    if count == 1:
+        return np.zeros(1, dtype=np.int64)
+    return np.unique(np.rint(np.linspace(0, n_steps, count)).astype(np.int64))
+
+
+def _build_body(scene, index, body):
+    key = f"body[{index}]"
+    if body.mesh is not None:
+        vertices, faces = geometry.load_mesh(body.mesh, body.units)
+    else:
+        s = body.shape
+        vertices, faces = geometry.primitive(s.type, size=s.size, radius=s.radius,
+                                             subdivisions=s.subdivisions, height=s.height,
+                                             sections=s.sections)
+    if body.resolution is not None:
+        vertices, faces = geometry.refine(vertices, faces, body.resolution)
+    needs_inertia = body.motion in ("free", "guided")
+    try:
+        mass, com, inertia = geometry.mass_properties(vertices, faces, density=body.density,
+                                                      mass=body.mass)
+    except geometry.MeshError:
+        if needs_inertia:
+            raise
+        area = geometry.tributary_areas(vertices, faces)
+        mass, com, inertia = float("nan"), area @ vertices / area.sum(), np.full((3, 3), np.nan)
+    area = geometry.tributary_areas(vertices, faces)
+    body_vertices = np.ascontiguousarray(vertices - com)
+
+    if scene.wear.direction == "vertex_normal":
+        wear_direction = np.ascontiguousarray(-geometry.vertex_normals(body_vertices, faces))
+    else:
+        wear_direction = np.zeros((0, 3))
+
+    q = np.asarray(body.orientation, float)
+    R = np.array(rotation_entries(q)).reshape(3, 3)
+    pose = np.zeros(13)
+    pose[0:3] = np.asarray(body.position, float) + R @ com
+    pose[3:7] = q
+    pose[7:10] = body.velocity
+    pose[10:13] = body.angular_velocity
+    gravity = np.asarray(scene.run.gravity, float)
+    acceleration = gravity + np.asarray(body.force, float) / mass if needs_inertia else gravity
+    path = Path(body.path) if body.path is not None else None
+    if body.motion == "free":
+        motion = FreeMotion(mass, inertia, acceleration)
+    elif body.motion == "guided":
+        motion = GuidedMotion(pose[0:3].copy(), path, body.path.free_axis, mass, acceleration)
+    elif body.motion == "prescribed":
+        motion = PrescribedMotion(pose[0:3].copy(), path)
+    else:
+        motion = FixedMotion()
+    motion.place(pose, 0.0)
+    if not np.all(np.isfinite(pose)):
+        raise SceneError(scene.source, key, "initial pose is not finite")
+    return BodyModel(
+        name=body.name, faces=faces, reference_vertices=body_vertices, tributary_area=area,
+        wear_direction=wear_direction,
+        reference_face_normals=geometry.face_normals(body_vertices, faces),
+        mass=float(mass), inertia=inertia, origin=-com, initial_pose=pose, motion=motion,
+        period=path.period if path is not None else None)
+
+
+def _pair(per_point, per_area):
+    """(per point, per area) coefficients: c_i = c_point + c_area A_i."""
+    return (0.0, float(per_area)) if per_area is not None else (float(per_point or 0.0), 0.0)
+
+
+def point_coefficients(model, body):
+    """Per-vertex ``c, d, c_t, d_t`` (n,) of ``body`` (N/m, N·s/m)."""
+    a = body.tributary_area
+    return tuple(model.law[5 + 2 * j] + model.law[6 + 2 * j] * a for j in range(4))
+
+
+def initial_state(model):
+    """Allocate the :class:`State` of ``model`` at t = 0."""
+    P = model.planes.shape[0]
+    bodies = []
+    for b in model.bodies:
+        n = len(b.tributary_area)
+        bodies.append(BodyState(
+            pose=b.initial_pose.copy(), vertices=b.reference_vertices.copy(),
+            wear_depth=np.zeros(n), friction_work=np.zeros(n),
+            contact_state=np.zeros((P, n), dtype=np.int8),
+            tangential=np.zeros((P, n, 4, 3)), normal_force=np.zeros((P, n))))
+    return State(time=0.0, step=0, bodies=bodies)
+
+
+def stable_time_step(model):
+    """Largest stable time step (s) of the dynamic bodies, and the body that sets it.
+
+    Bound: the contact stiffness of every vertex acting in all three directions
+    at once, ``K = sum_i max(c_i, c_t,i) J_i^T J_i`` with ``J_i = [I, -[r_i]x]``,
+    is at least the stiffness of any real contact configuration, so its largest
+    generalised eigenvalue against the mass matrix bounds the fastest contact
+    mode, rotations included. Each mode ``omega`` with damping ratio ``zeta``
+    is stable under the symplectic Euler step for
+    ``dt <= 2 (sqrt(1 + zeta^2) - zeta) / omega``; the result is that bound
+    times :data:`STABILITY_MARGIN`. Returns ``(inf, None)`` when no body is
+    integrated in time.
+    """
+    best, who = np.inf, None
+    for b in model.bodies:
+        kind = b.motion.dynamic_axes
+        if kind is None:
+            continue
+        c, d, ct, dtan = point_coefficients(model, b)
+        k, d = np.maximum(c, ct), np.maximum(d, dtan)
+        if kind == "axis":
+            K = np.array([[k.sum()]])
+            C = np.array([[d.sum()]])
+            M = np.array([[b.mass]])
+        else:
+            K, C = _contact_matrix(k, b.reference_vertices), _contact_matrix(d, b.reference_vertices)
+            M = np.zeros((6, 6))
+            M[:3, :3] = b.mass * np.eye(3)
+            M[3:, 3:] = b.inertia
+        dt = _stable_step(K, C, M)
+        if dt < best:
+            best, who = dt, b.name
+    return STABILITY_MARGIN * best, who
+
+
+def _contact_matrix(weights, r):
+    """sum_i w_i J_i^T J_i (6, 6) for J_i = [I, -[r_i]x]."""
+    out = np.zeros((6, 6))
+    w = weights.sum()
+    out[:3, :3] = w * np.eye(3)
+    wr = weights @ r
+    skew = np.array([[0.0, -wr[2], wr[1]], [wr[2], 0.0, -wr[0]], [-wr[1], wr[0], 0.0]])
+    out[:3, 3:] = -skew
+    out[3:, :3] = skew
+    out[3:, 3:] = np.einsum("i,i", weights, (r * r).sum(1)) * np.eye(3) - np.einsum("i,ij,ik->jk", weights, r, r)
+    return out
+
+
+def _stable_step(K, C, M):
+    """Smallest per-mode stability limit of the damped oscillator M x'' + C x' + K x = 0."""
+    w, U = np.linalg.eigh(M)
+    S = U @ np.diag(w ** -0.5) @ U.T
+    lam, phi = np.linalg.eigh(S @ K @ S)
+    Ct = S @ C @ S
+    best = np.inf
+    for j in range(len(lam)):
+        if lam[j] <= 0.0:
+            continue
+        omega = np.sqrt(lam[j])
+        zeta = phi[:, j] @ Ct @ phi[:, j] / (2.0 * omega)
+        best = min(best, 2.0 * (np.sqrt(1.0 + zeta * zeta) - zeta) / omega)
+    # a damping-dominated mode: b = c dt / m <= 2
+    c_max = np.linalg.eigvalsh(Ct).max()
+    if c_max > 0.0:
+        best = min(best, 2.0 / c_max)
+    return best

@@ -1,0 +1,100 @@
+"""Recorders: observers that turn a running state into the files of DESIGN.md §5.
+
+Physics never writes files; :func:`meshwear.simulate.run` calls
+``on_sample`` / ``on_frame`` and the CLI calls ``close`` with the summary.
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+from ..simulate import body_quantities
+from .tables import HISTORY_COLUMNS, HistoryWriter, write_json_atomic
+from .vtk import PVDSeries, plane_patch
+
+#: columns added to DESIGN.md §5's history.csv (extend, never rename)
+EXTRA_COLUMNS = ("wx", "wy", "wz", "tx", "ty", "tz", "contact_points", "stick_points", "slip_points")
+FIELDS = ("wear_depth", "normal_force", "friction_force", "pressure", "contact_state", "friction_work")
+
+
+class RunRecorder:
+    """Writes ``OUT/<body>.pvd`` series, ``history.csv`` and ``summary.json``.
+
+    Parameters
+    ----------
+    out_dir : path
+    model : meshwear.model.Model
+    """
+
+    def __init__(self, out_dir, model):
+        self.out_dir = Path(out_dir)
+        self.out_dir.mkdir(parents=True, exist_ok=True)
+        self.series = {b.name: PVDSeries(self.out_dir, b.name, b.faces) for b in model.bodies}
+        self.history = HistoryWriter(self.out_dir / "history.csv", EXTRA_COLUMNS)
+        for plane in model.plane_list:
+            vertices, faces = plane_patch(plane.point, plane.normal, plane.size)
+            patch = PVDSeries(self.out_dir, plane.name, faces)
+            patch.write_frame(0.0, vertices, {})
+            patch.close()
+
+    def on_sample(self, model, state):
+        for body, s in zip(model.bodies, state.bodies):
+            q = body_quantities(body, s)
+            states = q["contact_state"]
+            row = dict(zip(("x", "y", "z"), q["origin"]))
+            row.update(zip(("qw", "qx", "qy", "qz"), s.pose[3:7]))
+            row.update(zip(("vx", "vy", "vz"), s.pose[7:10]))
+            row.update(zip(("wx", "wy", "wz"), s.pose[10:13]))
+            row.update(zip(("fx", "fy", "fz", "tx", "ty", "tz"), s.wrench))
+            row.update(time=state.time, body=body.name, friction_work=q["total_friction_work"],
+                       wear_volume=q["wear_volume"], max_wear_depth=q["max_wear_depth"],
+                       contact_points=int((states > 0).sum()), stick_points=int((states == 1).sum()),
+                       slip_points=int((states == 2).sum()))
+            self.history.write(row)
+
+    def on_frame(self, model, state):
+        for body, s in zip(model.bodies, state.bodies):
+            q = body_quantities(body, s)
+            self.series[body.name].write_frame(state.time, q["points"], {k: q[k] for k in FIELDS})
+
+    def close(self, summary):
+        self.history.close()
+        for series in self.series.values():
+            series.close()
+        write_json_atomic(self.out_dir / "summary.json", summary)
+
+
+def summary(model, state, wall_time, status="ok", message=None):
+    """The ``summary.json`` object of DESIGN.md §5 (plus ``status``/``message``)."""
+    cycles = state.time / model.period if model.period else None
+    out = {
+        "format": 1,
+        "status": status,
+        "time": state.time,
+        "steps": state.step,
+        "dt": model.dt,
+        "cycles": cycles,
+        "resolved_cycles": cycles,
+        "wall_time": wall_time,
+        "bodies": {},
+    }
+    if message:
+        out["message"] = message
+    for body, s in zip(model.bodies, state.bodies):
+        q = body_quantities(body, s)
+        out["bodies"][body.name] = {
+            "wear_volume": q["wear_volume"],
+            "max_wear_depth": q["max_wear_depth"],
+            "friction_work": q["total_friction_work"],
+            "position": q["origin"].tolist(),
+            "orientation": s.pose[3:7].tolist(),
+            "velocity": s.pose[7:10].tolist(),
+            "angular_velocity": s.pose[10:13].tolist(),
+            "contact_force": s.wrench[0:3].tolist(),
+            "contact_points": int((q["contact_state"] > 0).sum()),
+            "vertices": int(len(s.wear_depth)),
+        }
+    return out
+
+
+__all__ = ["RunRecorder", "summary", "HISTORY_COLUMNS", "EXTRA_COLUMNS"]

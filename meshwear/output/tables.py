@@ -1,0 +1,128 @@
+"""``history.csv`` and JSON files (DESIGN.md §5), written so an interrupted run leaves them valid."""
+
+import csv
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+#: the columns DESIGN.md §5 fixes, in this order (others are appended, never renamed)
+HISTORY_COLUMNS = ("time", "body", "x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz",
+                   "fx", "fy", "fz", "friction_work", "wear_volume", "max_wear_depth")
+
+
+class HistoryWriter:
+    """``OUT/history.csv``: one row per body per sample.
+
+    Every row is flushed as it is written, so a run stopped at any moment leaves
+    a file of complete rows. Floats are written with ``repr`` (round-trip exact,
+    ``nan``/``inf`` as such).
+
+    Parameters
+    ----------
+    path : str or Path
+        Replaced if it exists.
+    extra_columns : sequence of str
+        Columns after :data:`HISTORY_COLUMNS`.
+    """
+
+    def __init__(self, path, extra_columns=()):
+        self.columns = tuple(HISTORY_COLUMNS) + tuple(extra_columns)
+        if len(set(self.columns)) != len(self.columns):
+            raise ValueError(f"duplicate history columns in {self.columns}")
+        self.path = Path(path)
+        self._file = open(self.path, "w", newline="", encoding="utf-8")
+        self._csv = csv.writer(self._file, lineterminator="\n")
+        self._csv.writerow(self.columns)
+        self._file.flush()
+
+    def write(self, row):
+        """Append one row.
+
+        Parameters
+        ----------
+        row : dict
+            Exactly the writer's columns (missing or unknown keys raise ValueError).
+        """
+        if self._file.closed:
+            raise RuntimeError(f"{self.path} is closed")
+        if row.keys() != set(self.columns):
+            missing = [c for c in self.columns if c not in row]
+            unknown = [k for k in row if k not in self.columns]
+            raise ValueError(f"history row: missing columns {missing}, unknown columns {unknown}")
+        self._csv.writerow([_cell(row[c]) for c in self.columns])
+        self._file.flush()
+
+    def close(self):
+        self._file.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def _cell(value):
+    if isinstance(value, (bool, np.bool_)):
+        return int(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return repr(float(value))
+    if isinstance(value, str):
+        return value
+    raise TypeError(f"history value {value!r} ({type(value).__name__}) is not a number or a string")
+
+
+def write_json_atomic(path, obj):
+    """Write ``obj`` as JSON to ``path`` atomically (temporary file, then ``os.replace``).
+
+    numpy scalars and arrays become plain numbers and lists, paths become
+    strings, and non-finite floats become ``null`` (strict JSON has no NaN).
+    """
+    write_text_atomic(path, json.dumps(_plain(obj), indent=2, allow_nan=False) + "\n")
+
+
+def write_text_atomic(path, text):
+    """Replace ``path`` by ``text`` atomically (temporary file in the same directory).
+
+    A reader, or a run killed mid-write, sees the old file or the new one, never a part.
+    """
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def _plain(obj):
+    """Recursively convert to JSON-native types."""
+    if isinstance(obj, dict):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _plain(obj.tolist())
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        value = float(obj)
+        return value if math.isfinite(value) else None
+    if isinstance(obj, Path):
+        return str(obj)
+    if obj is None or isinstance(obj, str):
+        return obj
+    raise TypeError(f"cannot write {type(obj).__name__} to JSON: {obj!r}")

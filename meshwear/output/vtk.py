@@ -1,0 +1,165 @@
+"""VTK time series for ParaView (DESIGN.md §5): a ``.pvd`` collection of ``.vtp`` frames.
+
+``OUT/<name>.pvd`` lists ``OUT/<name>/<name>_NNNNN.vtp``. The collection is
+rewritten atomically (temporary file, then ``os.replace``) after every frame, so
+a run stopped at any moment leaves a series ParaView opens.
+"""
+
+import re
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from .tables import write_text_atomic
+
+
+class PVDSeries:
+    """One body's (or surface's) series: ``OUT/<name>.pvd`` + ``OUT/<name>/<name>_NNNNN.vtp``.
+
+    The mesh connectivity is fixed; each frame gives new point positions and
+    point data. Opening a series replaces an older one of the same name (its
+    ``.pvd`` and its numbered frames).
+
+    Parameters
+    ----------
+    out_dir : str or Path
+    name : str
+        Series name, used for file names (no path separators).
+    faces : (m, 3) int
+    """
+
+    def __init__(self, out_dir, name, faces):
+        name = str(name)
+        if not name or name in (".", "..") or re.search(r"[/\\\x00]", name):
+            raise ValueError(f"series name {name!r}: must be non-empty and contain no path separators")
+        faces = np.ascontiguousarray(faces, dtype=np.int64)
+        if faces.ndim != 2 or faces.shape[1] != 3:
+            raise ValueError(f"faces have shape {faces.shape}, expected (m, 3)")
+        self.out_dir = Path(out_dir)
+        self.name = name
+        self.faces = faces
+        self.frame_dir = self.out_dir / name
+        self.pvd_path = self.out_dir / f"{name}.pvd"
+        self.frame_dir.mkdir(parents=True, exist_ok=True)
+        stale = re.compile(re.escape(name) + r"_\d{5,}\.vtp")
+        for old in self.frame_dir.iterdir():
+            if stale.fullmatch(old.name):
+                old.unlink()
+        self._entries = []          # (time, relative file name)
+        self._closed = False
+        self._write_pvd()           # an empty collection replaces any older series
+
+    def write_frame(self, time, points, point_data):
+        """Write one frame and list it in the ``.pvd``.
+
+        Parameters
+        ----------
+        time : float
+            s.
+        points : (n, 3) float
+            World coordinates (m).
+        point_data : dict of str -> (n,) or (n, k) array
+            Scalars or vectors per point; bool is stored as uint8.
+
+        Returns
+        -------
+        Path
+            The ``.vtp`` written.
+        """
+        if self._closed:
+            raise RuntimeError(f"series {self.name!r} is closed")
+        import pyvista
+
+        points = np.ascontiguousarray(points, dtype=np.float64)
+        if points.ndim != 2 or points.shape[1] != 3:
+            raise ValueError(f"points have shape {points.shape}, expected (n, 3)")
+        if len(self.faces) and self.faces.max() >= len(points):
+            raise ValueError(f"{len(points)} points, but the faces refer to point {self.faces.max()}")
+        mesh = pyvista.PolyData.from_regular_faces(points, self.faces)
+        for key, value in point_data.items():
+            value = np.asarray(value)
+            if value.dtype == bool:
+                value = value.astype(np.uint8)
+            if value.shape[0] != len(points) or value.ndim > 2:
+                raise ValueError(f"point data {key!r} has shape {value.shape}, expected ({len(points)},) "
+                                 f"or ({len(points)}, k)")
+            mesh.point_data[key] = np.ascontiguousarray(value)
+        mesh.field_data["TimeValue"] = np.array([float(time)])   # read by ParaView for a lone frame
+        index = len(self._entries)
+        relative = f"{self.name}/{self.name}_{index:05d}.vtp"
+        path = self.out_dir / relative
+        mesh.save(path, binary=True, compression="zlib")
+        self._entries.append((float(time), relative))
+        self._write_pvd()
+        return path
+
+    def _write_pvd(self):
+        lines = ['<?xml version="1.0"?>',
+                 '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+                 "  <Collection>"]
+        lines += [f'    <DataSet timestep="{t!r}" group="" part="0" file={quoteattr(f)}/>'
+                  for t, f in self._entries]
+        lines += ["  </Collection>", "</VTKFile>", ""]
+        write_text_atomic(self.pvd_path, "\n".join(lines))
+
+    @property
+    def times(self):
+        """list of float: times of the frames written so far."""
+        return [t for t, _ in self._entries]
+
+    def close(self):
+        """Finish the series (the ``.pvd`` is already complete after every frame)."""
+        self._closed = True
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def plane_patch(point, normal, size, divisions=1):
+    """A square patch of a plane, centred at ``point``, for drawing an analytic plane.
+
+    Parameters
+    ----------
+    point : (3,) float
+        Centre (m).
+    normal : (3,) float
+        Plane normal (need not be unit); the faces are wound so their normal is +normal.
+    size : float or (2,) float
+        Side length(s) (m).
+    divisions : int
+        Cells per side; the patch has 2·divisions² triangles.
+
+    Returns
+    -------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    """
+    point = np.asarray(point, np.float64).reshape(3)
+    normal = np.asarray(normal, np.float64).reshape(3)
+    length = np.linalg.norm(normal)
+    if not length > 0:
+        raise ValueError(f"normal {normal.tolist()} has zero length")
+    normal = normal / length
+    width, height = np.broadcast_to(np.asarray(size, np.float64), 2)
+    if not (width > 0 and height > 0):
+        raise ValueError(f"size {size!r} must be positive")
+    divisions = int(divisions)
+    if divisions < 1:
+        raise ValueError(f"divisions must be >= 1, got {divisions}")
+    # in-plane axes u, v with u x v = normal; u from the world axis least aligned with the normal
+    u = np.cross(normal, np.eye(3)[np.argmin(np.abs(normal))])
+    u /= np.linalg.norm(u)
+    v = np.cross(normal, u)
+    s = np.linspace(-0.5, 0.5, divisions + 1)
+    su, sv = np.meshgrid(s * width, s * height, indexing="ij")
+    vertices = point + su.reshape(-1, 1) * u + sv.reshape(-1, 1) * v
+    i, j = np.meshgrid(np.arange(divisions), np.arange(divisions), indexing="ij")
+    p00 = (i * (divisions + 1) + j).ravel()
+    p10, p01 = p00 + divisions + 1, p00 + 1
+    p11 = p10 + 1
+    faces = np.concatenate([np.stack([p00, p10, p11], axis=1), np.stack([p00, p11, p01], axis=1)])
+    return np.ascontiguousarray(vertices), np.ascontiguousarray(faces, dtype=np.int64)

@@ -1,0 +1,752 @@
+"""Scene files (TOML, format 1) → frozen, validated dataclasses.
+
+The TOML tables map one to one onto the dataclasses below (DESIGN.md §3).
+Every value is checked in the dataclass's ``__post_init__``, so
+``dataclasses.replace`` makes a checked variant for sweeps; the parser only
+checks the key names, resolves mesh paths and builds nested tables. Bad input
+raises :class:`SceneError`, one line naming the file, the key and what is wrong::
+
+    scene.toml: contact.stifness: unknown key (did you mean 'stiffness'?)
+
+Keys of bodies and surfaces are written by index: ``body[0].density``,
+``surface[1].normal`` (0-based, in file order).
+"""
+
+import dataclasses
+import difflib
+import math
+import numbers
+import os
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+FORMAT = 1
+MODES = ("dynamic", "quasi-static")
+WEAR_LAWS = ("energy", "energy_density", "archard")
+WEAR_DIRECTIONS = ("contact_normal", "vertex_normal")
+ACCELERATIONS = ("none", "cycle_jump")
+UNITS = ("m", "mm", "cm", "um", "in")
+MOTIONS = ("free", "guided", "prescribed", "fixed")
+SURFACE_TYPES = ("plane", "mesh")
+#: keys of each primitive shape besides ``type``, and the required ones
+SHAPE_KEYS = {"box": ("size",), "sphere": ("radius", "subdivisions"),
+              "cylinder": ("radius", "height", "sections")}
+SHAPE_REQUIRED = {"box": ("size",), "sphere": ("radius",), "cylinder": ("radius", "height")}
+PLANE_KEYS = ("point", "normal", "size")
+MESH_SURFACE_KEYS = ("mesh", "shape", "units", "resolution", "position", "orientation",
+                     "rotation", "path")
+_SAFE_NAME = re.compile(r"[A-Za-z0-9_.\-]+")
+
+
+class SceneError(ValueError):
+    """Bad scene input. ``str(err)`` is one line: ``<file>: <key>: <what is wrong>``.
+
+    Parameters
+    ----------
+    source : str
+        The scene file ("" when unknown, e.g. a dataclass built in a script).
+    key : str
+        Full key path (``run.dt``, ``body[0].path.free_axis``), or "".
+    message : str
+        What is wrong, and what is allowed.
+    """
+
+    def __init__(self, source: str, key: str, message: str):
+        self.source, self.key, self.message = source, key, message
+        text = ": ".join(part for part in (source, key, message) if part)
+        super().__init__(re.sub(r"\s*\n\s*", " ", text))
+
+    def __reduce__(self):
+        return type(self), (self.source, self.key, self.message)
+
+
+# ------------------------------------------------------------------ value checks
+# Each takes (key, value, ...), returns the normalised value or raises a
+# SceneError with the key relative to its dataclass; the parser adds the prefix.
+
+def _show(value):
+    """Short description of a value for messages."""
+    if isinstance(value, dict):
+        return "a table"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    text = repr(list(value) if isinstance(value, tuple) else value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _did_you_mean(word, options):
+    match = difflib.get_close_matches(str(word), list(options), n=1)
+    return f" (did you mean {match[0]!r}?)" if match else ""
+
+
+def _real(key, value):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise SceneError("", key, f"expected a number, got {_show(value)}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise SceneError("", key, f"must be a finite number, got {value!r}")
+    return value
+
+
+def _positive(key, value):
+    value = _real(key, value)
+    if value <= 0.0:
+        raise SceneError("", key, f"must be > 0, got {value!r}")
+    return value
+
+
+def _nonnegative(key, value):
+    value = _real(key, value)
+    if value < 0.0:
+        raise SceneError("", key, f"must be >= 0, got {value!r}")
+    return value
+
+
+def _integer(key, value, low, high=None):
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise SceneError("", key, f"expected an integer, got {_show(value)}")
+    value = int(value)
+    if value < low or (high is not None and value > high):
+        allowed = f"between {low} and {high}" if high is not None else f">= {low}"
+        raise SceneError("", key, f"must be {allowed}, got {value}")
+    return value
+
+
+def _choice(key, value, options):
+    if not isinstance(value, str):
+        raise SceneError("", key, f"expected a string, got {_show(value)}")
+    if value not in options:
+        listed = ", ".join(repr(o) for o in options)
+        raise SceneError("", key, f"{value!r} is not one of {listed}{_did_you_mean(value, options)}")
+    return value
+
+
+def _vector(key, value, n=3):
+    """Tuple of ``n`` finite floats (a list, tuple or numpy array is accepted)."""
+    if hasattr(value, "tolist") and not isinstance(value, numbers.Number):
+        value = value.tolist()
+    if (not isinstance(value, (list, tuple)) or len(value) != n
+            or any(isinstance(v, bool) or not isinstance(v, numbers.Real) for v in value)):
+        raise SceneError("", key, f"expected a list of {n} numbers, got {_show(value)}")
+    value = tuple(float(v) for v in value)
+    if not all(math.isfinite(v) for v in value):
+        raise SceneError("", key, f"must be finite numbers, got {_show(value)}")
+    return value
+
+
+def _direction(key, value, n=3):
+    """Unit vector (or unit quaternion for n = 4) along a non-zero ``value``."""
+    value = _vector(key, value, n)
+    norm = math.hypot(*value)
+    if norm == 0.0:
+        raise SceneError("", key, f"must be non-zero, got {_show(value)}")
+    return tuple(v / norm for v in value)
+
+
+def _name(key, value):
+    if not isinstance(value, str):
+        raise SceneError("", key, f"expected a string, got {_show(value)}")
+    if not _SAFE_NAME.fullmatch(value) or set(value) == {"."}:
+        raise SceneError("", key, f"{value!r} is not usable as a file name; use letters, "
+                                  "digits, '_', '-' and '.'")
+    return value
+
+
+def _instance(key, value, cls):
+    if not isinstance(value, cls):
+        raise SceneError("", key, f"expected a {cls.__name__}, got {_show(value)}")
+    return value
+
+
+def _set(obj, name, check, *args):
+    """Check field ``name`` of a frozen dataclass and store the normalised value."""
+    object.__setattr__(obj, name, check(name, getattr(obj, name), *args))
+
+
+def _set_optional(obj, name, check, *args):
+    if getattr(obj, name) is not None:
+        _set(obj, name, check, *args)
+
+
+def _exclusive(obj, a, b):
+    if getattr(obj, a) is not None and getattr(obj, b) is not None:
+        raise SceneError("", b, f"give either {a} or {b}, not both")
+
+
+def _check_mesh_or_shape(obj):
+    """Shared by bodies and mesh surfaces: exactly one of mesh/shape, units."""
+    if obj.mesh is not None and obj.shape is not None:
+        raise SceneError("", "shape", "give either mesh or shape, not both")
+    if obj.mesh is None and obj.shape is None:
+        raise SceneError("", "mesh", 'missing; give mesh = "file.stl" or shape = { type = ... }')
+    if obj.mesh is not None:
+        if not isinstance(obj.mesh, (str, os.PathLike)):
+            raise SceneError("", "mesh", f"expected a file name, got {_show(obj.mesh)}")
+        object.__setattr__(obj, "mesh", Path(obj.mesh))
+        if not obj.mesh.is_file():
+            raise SceneError("", "mesh", f"file not found: {obj.mesh}")
+    else:
+        _set(obj, "shape", _instance, ShapeConfig)
+    _set(obj, "units", _choice, UNITS)
+    if obj.shape is not None and obj.units != "m":
+        raise SceneError("", "units", "applies to mesh files only; shape dimensions are in metres")
+    _set_optional(obj, "resolution", _positive)
+    _set(obj, "position", _vector)
+    _set(obj, "orientation", _direction, 4)
+    _set_optional(obj, "path", _instance, PathConfig)
+
+
+# ------------------------------------------------------------------ dataclasses
+
+@dataclass(frozen=True, kw_only=True)
+class RunConfig:
+    """``[run]``: mode, duration (s), step dt (s), frames, history rows, gravity (m/s²).
+
+    ``frames = 0`` writes no VTK frames, 1 only t = 0; ``history >= 2``.
+    """
+
+    mode: str = "dynamic"
+    duration: float = 1.0
+    dt: float = 1e-5
+    frames: int = 51
+    history: int = 1001
+    gravity: tuple = (0.0, 0.0, -9.81)
+
+    def __post_init__(self):
+        _set(self, "mode", _choice, MODES)
+        _set(self, "duration", _positive)
+        _set(self, "dt", _positive)
+        if self.dt > self.duration:
+            raise SceneError("", "dt", f"{self.dt!r} s is longer than duration = {self.duration!r} s")
+        _set(self, "frames", _integer, 0)
+        _set(self, "history", _integer, 2)
+        _set(self, "gravity", _vector)
+
+
+@dataclass(frozen=True, kw_only=True)
+class ContactConfig:
+    """``[contact]``: penalty contact and friction, one law for all pairs.
+
+    Each coefficient is given per point (N/m, N·s/m) or per area (N/m³,
+    N·s/m³), never both. After construction the fields hold resolved values:
+    ``stiffness = 1e6`` and ``damping = 20.0`` when neither form is given,
+    ``static_friction = friction`` when omitted. ``tangential_*`` left at None
+    mean "same as the normal coefficient" (see :attr:`tangential`). A sweep
+    with ``dataclasses.replace`` that switches form sets the other to None.
+    """
+
+    stiffness: float | None = None
+    stiffness_per_area: float | None = None
+    damping: float | None = None
+    damping_per_area: float | None = None
+    friction: float = 0.3
+    static_friction: float | None = None
+    tangential_stiffness: float | None = None
+    tangential_stiffness_per_area: float | None = None
+    tangential_damping: float | None = None
+    tangential_damping_per_area: float | None = None
+
+    def __post_init__(self):
+        for base, check in (("stiffness", _positive), ("damping", _nonnegative),
+                            ("tangential_stiffness", _positive), ("tangential_damping", _nonnegative)):
+            _exclusive(self, base, base + "_per_area")
+            _set_optional(self, base, check)
+            _set_optional(self, base + "_per_area", check)
+        if self.stiffness is None and self.stiffness_per_area is None:
+            object.__setattr__(self, "stiffness", 1e6)
+        if self.damping is None and self.damping_per_area is None:
+            object.__setattr__(self, "damping", 20.0)
+        _set(self, "friction", _nonnegative)
+        if self.static_friction is None:
+            object.__setattr__(self, "static_friction", self.friction)
+        _set(self, "static_friction", _nonnegative)
+        if self.static_friction < self.friction:
+            raise SceneError("", "static_friction", f"{self.static_friction!r} is below friction = "
+                             f"{self.friction!r}; static friction must be >= friction")
+
+    @property
+    def tangential(self):
+        """Resolved tangential coefficients ``((c_t, c_t_per_area), (d_t, d_t_per_area))``,
+        exactly one of each pair not None."""
+        def pair(base, normal):
+            given = (getattr(self, "tangential_" + base), getattr(self, f"tangential_{base}_per_area"))
+            return given if given != (None, None) else normal
+        return (pair("stiffness", (self.stiffness, self.stiffness_per_area)),
+                pair("damping", (self.damping, self.damping_per_area)))
+
+
+@dataclass(frozen=True, kw_only=True)
+class WearConfig:
+    """``[wear]``: law, coefficient (m/J, m³/J or 1/Pa), direction, acceleration.
+
+    ``period`` (s) is the cycle length for ``cycle_jump`` (None: from the
+    motion's frequency); ``tolerance`` the relative error allowed on wear depth.
+    """
+
+    law: str = "energy"
+    coefficient: float = 1e-9
+    direction: str = "contact_normal"
+    acceleration: str = "none"
+    period: float | None = None
+    tolerance: float = 0.01
+
+    def __post_init__(self):
+        _set(self, "law", _choice, WEAR_LAWS)
+        _set(self, "coefficient", _nonnegative)
+        _set(self, "direction", _choice, WEAR_DIRECTIONS)
+        _set(self, "acceleration", _choice, ACCELERATIONS)
+        _set_optional(self, "period", _positive)
+        _set(self, "tolerance", _real)
+        if not 0.0 < self.tolerance < 1.0:
+            raise SceneError("", "tolerance", f"must be between 0 and 1 (exclusive), got {self.tolerance!r}")
+
+
+@dataclass(frozen=True, kw_only=True)
+class ShapeConfig:
+    """A primitive instead of a mesh file, in metres: ``box`` (size = [x, y, z]),
+    ``sphere`` (radius, subdivisions 0..7), ``cylinder`` (radius, height, sections >= 3)."""
+
+    type: str
+    size: tuple | None = None
+    radius: float | None = None
+    subdivisions: int = 3
+    height: float | None = None
+    sections: int = 32
+
+    def __post_init__(self):
+        _set(self, "type", _choice, tuple(SHAPE_KEYS))
+        for key in SHAPE_REQUIRED[self.type]:
+            if getattr(self, key) is None:
+                needs = " and ".join(SHAPE_REQUIRED[self.type])
+                raise SceneError("", key, f"missing; a {self.type} needs {needs}")
+        for key in ("size", "radius", "height"):
+            if key not in SHAPE_KEYS[self.type] and getattr(self, key) is not None:
+                raise SceneError("", key, f"does not apply to a {self.type}")
+        if self.size is not None:
+            _set(self, "size", _vector)
+            if min(self.size) <= 0.0:
+                raise SceneError("", "size", f"all three must be > 0, got {_show(self.size)}")
+        _set_optional(self, "radius", _positive)
+        _set_optional(self, "height", _positive)
+        _set(self, "subdivisions", _integer, 0, 7)
+        _set(self, "sections", _integer, 3)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Oscillation:
+    """Displacement ``amplitude·sin(2π·frequency·t)`` (m, Hz) along unit ``axis``."""
+
+    axis: tuple
+    amplitude: float
+    frequency: float
+
+    def __post_init__(self):
+        _set(self, "axis", _direction)
+        _set(self, "amplitude", _nonnegative)
+        _set(self, "frequency", _positive)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Circle:
+    """A circular track of ``radius`` (m) run at ``frequency`` (Hz) about unit ``normal``."""
+
+    radius: float
+    frequency: float
+    normal: tuple = (0.0, 0.0, 1.0)
+
+    def __post_init__(self):
+        _set(self, "radius", _positive)
+        _set(self, "frequency", _positive)
+        _set(self, "normal", _direction)
+
+
+@dataclass(frozen=True, kw_only=True)
+class PathConfig:
+    """``path``: displacement added to the initial position; the components given
+    add up. ``velocity`` (m/s) is steady sliding; ``free_axis`` (unit) is the
+    free direction of a guided body."""
+
+    oscillation: Oscillation | None = None
+    velocity: tuple | None = None
+    circle: Circle | None = None
+    free_axis: tuple | None = None
+
+    def __post_init__(self):
+        _set_optional(self, "oscillation", _instance, Oscillation)
+        _set_optional(self, "velocity", _vector)
+        _set_optional(self, "circle", _instance, Circle)
+        _set_optional(self, "free_axis", _direction)
+
+    @property
+    def periodic(self):
+        """True when the path has a cycle (an oscillation or a circle)."""
+        return self.oscillation is not None or self.circle is not None
+
+
+@dataclass(frozen=True, kw_only=True)
+class RotationConfig:
+    """Steady rotation of a mesh surface: unit ``axis``, ``rate`` (rad/s), ``center`` (m)."""
+
+    axis: tuple
+    rate: float
+    center: tuple = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        _set(self, "axis", _direction)
+        _set(self, "rate", _real)
+        _set(self, "center", _vector)
+
+
+@dataclass(frozen=True, kw_only=True)
+class BodyConfig:
+    """``[[body]]``: a worn rigid body.
+
+    Exactly one of ``mesh`` (a file, resolved against the scene's folder, in
+    ``units``) and ``shape``. Exactly one of ``density`` (kg/m³, default 7850)
+    and ``mass`` (kg). ``orientation`` is a quaternion (w, x, y, z), stored
+    normalised. ``guided`` bodies need a path with ``free_axis``;
+    ``prescribed`` ones a path without it; ``free`` and ``fixed`` ones no path.
+    Velocities and ``force`` do not apply to prescribed and fixed bodies.
+    """
+
+    name: str
+    mesh: Path | None = None
+    shape: ShapeConfig | None = None
+    units: str = "m"
+    resolution: float | None = None
+    density: float | None = None
+    mass: float | None = None
+    position: tuple = (0.0, 0.0, 0.0)
+    orientation: tuple = (1.0, 0.0, 0.0, 0.0)
+    velocity: tuple = (0.0, 0.0, 0.0)
+    angular_velocity: tuple = (0.0, 0.0, 0.0)
+    force: tuple = (0.0, 0.0, 0.0)
+    motion: str = "free"
+    path: PathConfig | None = None
+
+    def __post_init__(self):
+        _set(self, "name", _name)
+        _check_mesh_or_shape(self)
+        _exclusive(self, "density", "mass")
+        _set_optional(self, "density", _positive)
+        _set_optional(self, "mass", _positive)
+        if self.density is None and self.mass is None:
+            object.__setattr__(self, "density", 7850.0)
+        for key in ("velocity", "angular_velocity", "force"):
+            _set(self, key, _vector)
+        _set(self, "motion", _choice, MOTIONS)
+        if self.motion in ("free", "fixed") and self.path is not None:
+            raise SceneError("", "path", f"a {self.motion} body has no path; "
+                                         "use motion = \"guided\" or \"prescribed\"")
+        if self.motion in ("guided", "prescribed") and self.path is None:
+            raise SceneError("", "path", f"missing; a {self.motion} body needs a path")
+        if self.motion == "guided" and self.path.free_axis is None:
+            raise SceneError("", "path.free_axis", "missing; a guided body needs the axis "
+                                                   "along which it moves freely")
+        if self.motion == "prescribed" and self.path.free_axis is not None:
+            raise SceneError("", "path.free_axis", "applies to guided bodies only; a "
+                                                   "prescribed body follows its path exactly")
+        if self.motion in ("prescribed", "fixed"):
+            for key in ("velocity", "angular_velocity", "force"):
+                if any(getattr(self, key)):
+                    raise SceneError("", key, f"does not apply to a {self.motion} body "
+                                              "(its motion is set, not computed)")
+
+
+@dataclass(frozen=True, kw_only=True)
+class SurfaceConfig:
+    """``[[surface]]``: a counter-surface (does not wear).
+
+    ``type = "plane"``: ``point``, unit ``normal`` (pointing into the bodies) and
+    an optional ``size`` (m, side of the patch drawn in ParaView).
+    ``type = "mesh"``: mesh or shape, units, resolution, position, orientation as
+    for a body, plus an optional ``rotation`` and ``path`` (without free_axis).
+    """
+
+    name: str
+    type: str = "plane"
+    point: tuple = (0.0, 0.0, 0.0)
+    normal: tuple = (0.0, 0.0, 1.0)
+    size: float | None = None
+    mesh: Path | None = None
+    shape: ShapeConfig | None = None
+    units: str = "m"
+    resolution: float | None = None
+    position: tuple = (0.0, 0.0, 0.0)
+    orientation: tuple = (1.0, 0.0, 0.0, 0.0)
+    rotation: RotationConfig | None = None
+    path: PathConfig | None = None
+
+    def __post_init__(self):
+        _set(self, "name", _name)
+        _set(self, "type", _choice, SURFACE_TYPES)
+        if self.type == "plane":
+            _set(self, "point", _vector)
+            _set(self, "normal", _direction)
+            _set_optional(self, "size", _positive)
+            for key in ("mesh", "shape", "resolution", "rotation", "path"):
+                if getattr(self, key) is not None:
+                    raise SceneError("", key, 'applies to type = "mesh" surfaces only')
+            return
+        if self.size is not None:
+            raise SceneError("", "size", 'applies to type = "plane" surfaces only')
+        _check_mesh_or_shape(self)
+        _set_optional(self, "rotation", _instance, RotationConfig)
+        if self.path is not None and self.path.free_axis is not None:
+            raise SceneError("", "path.free_axis", "applies to guided bodies only; "
+                                                   "a surface follows its path exactly")
+
+
+@dataclass(frozen=True, kw_only=True)
+class Scene:
+    """A whole scene: ``format`` (must be 1), where it came from, and its tables.
+
+    ``source`` names the file in error messages; ``base_dir`` is the folder
+    mesh paths were resolved against.
+    """
+
+    format: int
+    source: str = "<scene>"
+    base_dir: Path = Path(".")
+    run: RunConfig = field(default_factory=RunConfig)
+    contact: ContactConfig = field(default_factory=ContactConfig)
+    wear: WearConfig = field(default_factory=WearConfig)
+    bodies: tuple = ()
+    surfaces: tuple = ()
+
+    def __post_init__(self):
+        def fail(key, message):
+            raise SceneError(self.source, key, message)
+
+        try:
+            _check_format(self.format)
+            _set(self, "run", _instance, RunConfig)
+            _set(self, "contact", _instance, ContactConfig)
+            _set(self, "wear", _instance, WearConfig)
+        except SceneError as err:
+            fail(err.key, err.message)
+        object.__setattr__(self, "base_dir", Path(self.base_dir))
+        object.__setattr__(self, "bodies", tuple(self.bodies))
+        object.__setattr__(self, "surfaces", tuple(self.surfaces))
+        if not self.bodies:
+            fail("body", "no bodies; add at least one [[body]] table")
+        items = ([(f"body[{i}]", b, BodyConfig) for i, b in enumerate(self.bodies)]
+                 + [(f"surface[{j}]", s, SurfaceConfig) for j, s in enumerate(self.surfaces)])
+        seen = {}
+        for key, item, cls in items:
+            if not isinstance(item, cls):
+                fail(key, f"expected a {cls.__name__}, got {_show(item)}")
+            if item.name in seen:
+                fail(key + ".name", f"{item.name!r} is already the name of {seen[item.name]}")
+            seen[item.name] = key
+        if self.run.mode == "quasi-static":
+            for i, b in enumerate(self.bodies):
+                if b.motion == "free":
+                    fail(f"body[{i}].motion", "'free' is not allowed with run.mode = "
+                         "'quasi-static'; use guided, prescribed or fixed")
+        if self.wear.acceleration == "cycle_jump" and self.wear.period is None and not any(
+                (x.path is not None and x.path.periodic)
+                or (getattr(x, "rotation", None) is not None and x.rotation.rate != 0.0)
+                for x in self.bodies + self.surfaces):
+            fail("wear.period", "missing; 'cycle_jump' needs a cycle length: set wear.period "
+                 "or give a path with an oscillation or a circle")
+
+
+def _check_format(value):
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise SceneError("", "format", f"expected the integer {FORMAT}, got {_show(value)}")
+    if value != FORMAT:
+        raise SceneError("", "format", f"version {value} is not supported; "
+                                       f"this meshwear reads format = {FORMAT}")
+
+
+# ------------------------------------------------------------------ parser
+
+def load_scene(path) -> Scene:
+    """Read and validate a scene file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        TOML file; mesh paths in it are relative to its folder.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SceneError
+        Missing or unreadable file, TOML syntax error (key = its line and
+        column), or any invalid key or value.
+    """
+    path = Path(path)
+    source = str(path)
+    try:
+        text = path.read_bytes().decode("utf-8-sig")
+    except FileNotFoundError:
+        raise SceneError(source, "", "file not found") from None
+    except IsADirectoryError:
+        raise SceneError(source, "", "is a folder, not a scene file") from None
+    except OSError as err:
+        raise SceneError(source, "", f"cannot read: {err.strerror or err}") from None
+    except UnicodeDecodeError:
+        raise SceneError(source, "", "not a UTF-8 text file") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        message = str(err)
+        where = re.search(r"\s*\(at (line \d+, column \d+|end of document)\)$", message)
+        location = where.group(1) if where else ""
+        message = message[:where.start()] if where else message
+        raise SceneError(source, location, f"TOML syntax error: {message}") from None
+    return parse_scene(data, source, path.resolve().parent)
+
+
+def parse_scene(data: dict, source: str = "<scene>", base_dir: Path = Path(".")) -> Scene:
+    """Validate parsed TOML (a dict of tables) and build the :class:`Scene`.
+
+    Parameters
+    ----------
+    data : dict
+        As returned by ``tomllib``.
+    source : str
+        Name of the scene in error messages.
+    base_dir : path
+        Folder that relative mesh paths are resolved against.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    SceneError
+    """
+    base_dir = Path(base_dir)
+    if not isinstance(data, dict):
+        raise SceneError(source, "", f"expected a table of keys, got {_show(data)}")
+    if "format" not in data:
+        raise SceneError(source, "format", f"missing; a scene file starts with format = {FORMAT}")
+    try:
+        _check_format(data["format"])
+    except SceneError as err:
+        raise SceneError(source, err.key, err.message) from None
+    _check_keys(source, data, "", ("format", "run", "contact", "wear", "body", "surface"))
+    tables = {name: _simple(cls, data.get(name, {}), name, source)
+              for name, cls in (("run", RunConfig), ("contact", ContactConfig), ("wear", WearConfig))}
+    bodies = _array(source, data.get("body", []), "body")
+    if not bodies:
+        raise SceneError(source, "body", "no bodies; add at least one [[body]] table")
+    bodies = [_body(source, base_dir, raw, f"body[{i}]") for i, raw in enumerate(bodies)]
+    surfaces = [_surface(source, base_dir, raw, f"surface[{j}]")
+                for j, raw in enumerate(_array(source, data.get("surface", []), "surface"))]
+    return Scene(format=data["format"], source=source, base_dir=base_dir, bodies=tuple(bodies),
+                 surfaces=tuple(surfaces), **tables)
+
+
+def _array(source, value, key):
+    """An array of tables; a single table ``[body]`` counts as one."""
+    if isinstance(value, dict):
+        return [value]
+    if not isinstance(value, list):
+        raise SceneError(source, key, f"expected [[{key}]] tables, got {_show(value)}")
+    return value
+
+
+def _check_keys(source, table, prefix, allowed, foreign=(), kind=""):
+    """Every key of ``table`` must be in ``allowed``; keys in ``foreign`` belong
+    to another ``type`` and get a message saying so."""
+    for key in table:
+        if key in allowed:
+            continue
+        full = f"{prefix}.{key}" if prefix else key
+        if key in foreign:
+            raise SceneError(source, full, f"does not apply to {kind}")
+        hint = _did_you_mean(key, allowed) or f"; valid keys: {', '.join(allowed)}"
+        raise SceneError(source, full, "unknown key" + hint)
+
+
+def _table(source, value, prefix, cls, allowed=None, foreign=(), kind=""):
+    """Check that ``value`` is a table with known keys and the required ones."""
+    if not isinstance(value, dict):
+        raise SceneError(source, prefix, f"expected a table, got {_show(value)}")
+    names = [f.name for f in dataclasses.fields(cls)]
+    _check_keys(source, value, prefix, allowed or names, foreign, kind)
+    for f in dataclasses.fields(cls):
+        if (f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+                and f.name not in value):
+            raise SceneError(source, f"{prefix}.{f.name}", "missing (required)")
+    return dict(value)
+
+
+def _build(cls, source, prefix, kwargs):
+    """``cls(**kwargs)``, with the error's key prefixed and the file named."""
+    try:
+        return cls(**kwargs)
+    except SceneError as err:
+        if err.source:  # raised by a nested table, already complete
+            raise
+        raise SceneError(source, f"{prefix}.{err.key}", err.message) from None
+
+
+def _simple(cls, value, prefix, source):
+    return _build(cls, source, prefix, _table(source, value, prefix, cls))
+
+
+def _typed(source, value, prefix, options, default=None):
+    """The ``type`` of a table, checked before its other keys."""
+    if not isinstance(value, dict):
+        raise SceneError(source, prefix, f"expected a table, got {_show(value)}")
+    if "type" not in value and default is None:
+        raise SceneError(source, f"{prefix}.type", "missing; one of "
+                         + ", ".join(repr(o) for o in options))
+    try:
+        return _choice("type", value.get("type", default), options)
+    except SceneError as err:
+        raise SceneError(source, f"{prefix}.type", err.message) from None
+
+
+def _shape(source, value, prefix):
+    kind = _typed(source, value, prefix, tuple(SHAPE_KEYS))
+    others = {k for keys in SHAPE_KEYS.values() for k in keys} - set(SHAPE_KEYS[kind])
+    table = _table(source, value, prefix, ShapeConfig, ("type",) + SHAPE_KEYS[kind], others,
+                   f"a {kind} (its keys: {', '.join(SHAPE_KEYS[kind])})")
+    return _build(ShapeConfig, source, prefix, table)
+
+
+def _path(source, value, prefix):
+    table = _table(source, value, prefix, PathConfig)
+    for key, cls in (("oscillation", Oscillation), ("circle", Circle)):
+        if key in table:
+            table[key] = _simple(cls, table[key], f"{prefix}.{key}", source)
+    return _build(PathConfig, source, prefix, table)
+
+
+def _geometry(source, base_dir, table, prefix):
+    """Resolve the mesh path and build the shape and path of a body or surface."""
+    if isinstance(table.get("mesh"), str):
+        table["mesh"] = base_dir / table["mesh"]
+    if "shape" in table:
+        table["shape"] = _shape(source, table["shape"], f"{prefix}.shape")
+    if "path" in table:
+        table["path"] = _path(source, table["path"], f"{prefix}.path")
+    return table
+
+
+def _body(source, base_dir, value, prefix):
+    table = _geometry(source, base_dir, _table(source, value, prefix, BodyConfig), prefix)
+    return _build(BodyConfig, source, prefix, table)
+
+
+def _surface(source, base_dir, value, prefix):
+    kind = _typed(source, value, prefix, SURFACE_TYPES, default="plane")
+    own, other = (PLANE_KEYS, MESH_SURFACE_KEYS) if kind == "plane" else (MESH_SURFACE_KEYS, PLANE_KEYS)
+    table = _table(source, value, prefix, SurfaceConfig, ("name", "type") + own, other,
+                   f'a type = "{kind}" surface')
+    table = _geometry(source, base_dir, table, prefix)
+    if "rotation" in table:
+        table["rotation"] = _simple(RotationConfig, table["rotation"], f"{prefix}.rotation", source)
+    return _build(SurfaceConfig, source, prefix, table)

@@ -1,0 +1,118 @@
+"""Plain-numpy twins of the numba kernels, written array-at-a-time.
+
+They follow DESIGN.md §1 directly and share no code with meshwear.kernels, so
+agreement between the two is evidence about both. The benchmark imports the
+contact twin as its same-run reference.
+"""
+
+import numpy as np
+
+NO_CONTACT, STICK, SLIP = 0, 1, 2
+ENERGY, ENERGY_DENSITY, ARCHARD = 0, 1, 2
+
+
+def quaternion_matrix(q):
+    w, x, y, z = q
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def _dot(a, b):
+    return np.einsum("ij,ij->i", a, b)
+
+
+def point_coefficients(area, law):
+    """c, d, c_t, d_t (n,) from the (per point, per area) pairs of ``law``."""
+    return tuple(law[5 + 2 * j] + law[6 + 2 * j] * area for j in range(4))
+
+
+def plane_contact(body_vertices, pose, planes, area, law, wear_direction,
+                  contact_state, tangential, normal_force, friction_work, wear_depth, wrench):
+    """Same contract as :func:`meshwear.kernels.contact.plane_contact`."""
+    f, f0, wear_law, k, dt = law[0], law[1], int(law[2]), law[3], law[4]
+    c, d, ct, dtan = point_coefficients(area, law)
+    R = quaternion_matrix(pose[3:7])
+    r = body_vertices @ R.T
+    x = pose[0:3] + r
+    u = pose[7:10] + np.cross(pose[10:13], r)
+    force = np.zeros_like(x)
+    moves = np.zeros_like(x)
+    for s in range(planes.shape[0]):
+        p, n, vel = planes[s]
+        delta = (x - p) @ n
+        touching = delta < 0.0
+        g = u - vel
+        rate = g @ n
+        slip_v = g - np.outer(rate, n)
+        load = np.where(touching, np.maximum(-(c * delta + d * rate), 0.0), 0.0)
+        on_plane = x - np.outer(delta, n)
+        T = tangential[s]
+        state = contact_state[s].copy()
+        anchor, F0, F_old, v_old = T[:, 0].copy(), T[:, 1].copy(), T[:, 2].copy(), T[:, 3].copy()
+
+        new = touching & (state == NO_CONTACT)
+        anchor[new], F0[new], v_old[new] = on_plane[new], 0.0, slip_v[new]
+        reversed_ = touching & (state == SLIP) & (_dot(slip_v, v_old) < 0.0)
+        # stick starts at the turning point, one step back along the slip velocity
+        anchor[reversed_] = on_plane[reversed_] - dt * slip_v[reversed_]
+        F0[reversed_] = F_old[reversed_]
+        state[new | reversed_] = STICK
+
+        speed = np.linalg.norm(slip_v, axis=1)
+        e = on_plane - anchor
+        e -= np.outer(e @ n, n)
+        trial = F0 - ct[:, None] * e - dtan[:, None] * slip_v
+        trial -= np.outer(trial @ n, n)
+        trial_mag = np.linalg.norm(trial, axis=1)
+        stick = touching & (state == STICK) & ~(trial_mag > f0 * load)
+        breaks = touching & (state == STICK) & (trial_mag > f0 * load)
+        v_old[breaks & (speed == 0.0)] = -trial[breaks & (speed == 0.0)]
+        slip = touching & ((state == SLIP) | breaks)
+        moving = touching & (speed > 0.0)
+        v_old[moving] = slip_v[moving]
+        v_norm = np.linalg.norm(v_old, axis=1)
+        safe = np.where(v_norm > 0.0, v_norm, 1.0)
+        slip_force = np.where((v_norm > 0.0)[:, None], -(f * load / safe)[:, None] * v_old, 0.0)
+        F = np.where(stick[:, None], trial, np.where(slip[:, None], slip_force, 0.0))
+        energy = np.where(stick, dtan * speed ** 2 * dt, np.where(slip, f * load * speed * dt, 0.0))
+        if wear_law == ENERGY:
+            dw = k * energy
+        elif wear_law == ENERGY_DENSITY:
+            dw = k * energy / area
+        else:
+            dw = np.where(slip, k * load / area * speed * dt, 0.0)
+
+        contact_state[s] = np.where(touching, np.where(slip, SLIP, STICK), NO_CONTACT)
+        normal_force[s] = load
+        T[:, 0], T[:, 1], T[:, 3] = anchor, F0, v_old
+        T[:, 2] = F
+        friction_work += energy
+        wear_depth += dw
+        direction = wear_direction if wear_direction.shape[0] else np.tile(R.T @ n, (len(dw), 1))
+        moves += dw[:, None] * direction
+        force += np.where(touching[:, None], load[:, None] * n + F, 0.0)
+    body_vertices += moves
+    wrench[0:3] = force.sum(axis=0)
+    wrench[3:6] = np.cross(r, force).sum(axis=0)
+
+
+def free_step(pose, wrench, inverse_mass, inertia_body, inverse_inertia_body, acceleration, dt):
+    """Same contract as :func:`meshwear.kernels.rigid.free_step`."""
+    pose[7:10] += dt * (wrench[0:3] * inverse_mass + acceleration)
+    R = quaternion_matrix(pose[3:7])
+    L = R @ inertia_body @ R.T @ pose[10:13] + dt * wrench[3:6]
+    omega = R @ inverse_inertia_body @ R.T @ L
+    pose[0:3] += dt * pose[7:10]
+    angle = np.linalg.norm(omega) * dt
+    if angle > 0.0:
+        axis = omega / np.linalg.norm(omega)
+        dq = np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * axis])
+        w0, v0 = dq[0], dq[1:]
+        w1, v1 = pose[3], pose[4:7]
+        q = np.concatenate([[w0 * w1 - v0 @ v1], w0 * v1 + w1 * v0 + np.cross(v0, v1)])
+        pose[3:7] = q / np.linalg.norm(q)
+    R = quaternion_matrix(pose[3:7])
+    pose[10:13] = R @ inverse_inertia_body @ R.T @ L

@@ -1,0 +1,318 @@
+"""Mesh loading, cleaning, primitives, refinement, areas, normals and mass properties."""
+
+import logging
+
+import numpy as np
+import pytest
+import trimesh
+
+from meshwear import geometry
+from meshwear.geometry import MeshError
+
+
+def watertight(vertices, faces):
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    return mesh.is_watertight and mesh.is_winding_consistent
+
+
+def area(vertices, faces):
+    return geometry.tributary_areas(vertices, faces).sum()
+
+
+def edge_lengths(vertices, faces):
+    tri = vertices[faces]
+    return np.linalg.norm(np.roll(tri, -1, axis=1) - tri, axis=2)
+
+
+def check_arrays(vertices, faces):
+    assert vertices.dtype == np.float64 and vertices.flags.c_contiguous and vertices.shape[1] == 3
+    assert faces.dtype == np.int64 and faces.flags.c_contiguous and faces.shape[1] == 3
+
+
+# ---------------------------------------------------------------- loading
+
+def test_stl_seams_are_merged_and_units_scale(tmp_path, caplog):
+    path = tmp_path / "box.stl"
+    trimesh.creation.box(extents=[1.0, 2.0, 3.0]).export(path)
+    assert len(trimesh.load(path, force="mesh", process=False).vertices) == 36
+    with caplog.at_level(logging.INFO, logger="meshwear.geometry"):
+        vertices, faces = geometry.load_mesh(path, units="mm")
+    check_arrays(vertices, faces)
+    assert (len(vertices), len(faces)) == (8, 12)
+    assert "merged 28 duplicate vertices" in caplog.text
+    np.testing.assert_allclose(np.ptp(vertices, axis=0), [1e-3, 2e-3, 3e-3], rtol=1e-12)
+    assert watertight(vertices, faces)
+
+
+@pytest.mark.parametrize("suffix", ["obj", "ply", "off", "glb"])
+def test_other_formats_load(tmp_path, suffix):
+    path = tmp_path / f"box.{suffix}"
+    trimesh.creation.box(extents=[1.0, 2.0, 3.0]).export(path)
+    vertices, faces = geometry.load_mesh(path, units="cm")
+    assert (len(vertices), len(faces)) == (8, 12)
+    np.testing.assert_allclose(np.ptp(vertices, axis=0), [0.01, 0.02, 0.03], rtol=1e-12)
+    assert watertight(vertices, faces)
+
+
+@pytest.mark.parametrize("content, reason", [
+    ("v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "NaN"),
+    ("v inf 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "NaN or infinite"),
+    ("", "no triangle faces"),
+    ("this is not a mesh\n", "no triangle faces"),
+    ("v 0 0 0\nv 1 0 0\n", "no triangle faces"),
+])
+def test_bad_files_are_refused_naming_the_file(tmp_path, content, reason):
+    path = tmp_path / "bad.obj"
+    path.write_text(content)
+    with pytest.raises(MeshError, match=reason) as err:
+        geometry.load_mesh(path)
+    assert str(path) in str(err.value) and "\n" not in str(err.value)
+
+
+def test_garbage_and_missing_files_are_refused(tmp_path):
+    garbage = tmp_path / "garbage.stl"
+    garbage.write_bytes(b"\x00\x17solid?" * 50)
+    with pytest.raises(MeshError, match="garbage.stl"):
+        geometry.load_mesh(garbage)
+    with pytest.raises(MeshError, match="missing.stl: mesh file not found"):
+        geometry.load_mesh(tmp_path / "missing.stl")
+    with pytest.raises(MeshError, match="garbage.stl: units 'furlong'"):
+        geometry.load_mesh(garbage, units="furlong")
+
+
+def test_zero_area_and_duplicate_faces_dropped(caplog):
+    vertices, faces = geometry.primitive("box", size=1.0)
+    extra = np.array([[0, 0, 1], faces[3], faces[3][::-1]])        # repeated index, duplicates
+    with caplog.at_level(logging.WARNING, logger="meshwear.geometry"):
+        v, f = geometry.clean(vertices, np.concatenate([faces, extra]), source="box.stl")
+    assert len(f) == 12 and watertight(v, f)
+    assert "box.stl: removed 1 degenerate face(s)" in caplog.text and "2 duplicate face(s)" in caplog.text
+
+
+def test_collinear_sliver_removed_keeping_the_mesh_closed():
+    # a zero-area face (a, b, m) with m the midpoint of edge (a, b): closed but degenerate
+    vertices, faces = geometry.primitive("box", size=[1.0, 2.0, 3.0])
+    a, b, c = faces[0]
+    m = len(vertices)
+    vertices = np.vstack([vertices, 0.5 * (vertices[a] + vertices[b])])
+    faces = np.vstack([faces[1:], [[a, m, c], [m, b, c], [a, b, m]]])
+    assert watertight(vertices, faces)
+    v, f = geometry.clean(vertices, faces)
+    assert len(v) == 9 and len(f) == 14
+    assert watertight(v, f)
+    assert np.all(np.linalg.norm(geometry.face_normals(v, f), axis=1) > 0.5)
+    assert area(v, f) == pytest.approx(22.0, rel=1e-12)
+
+
+def test_inside_out_closed_mesh_is_flipped(caplog):
+    vertices, faces = geometry.primitive("box", size=1.0)
+    with caplog.at_level(logging.WARNING, logger="meshwear.geometry"):
+        v, f = geometry.clean(vertices, faces[:, ::-1], source="inside-out.stl")
+    assert "inside-out.stl: faces were wound inwards" in caplog.text
+    assert trimesh.Trimesh(v, f, process=False).volume == pytest.approx(1.0)
+    assert np.all(np.einsum("ij,ij->i", geometry.vertex_normals(v, f), v) > 0)
+
+
+def test_stray_vertices_and_near_duplicates_are_merged():
+    vertices, faces = geometry.primitive("box", size=1.0)
+    jitter = vertices + 1e-12                                   # within 1e-9 of the diagonal
+    v = np.vstack([vertices, jitter, [[5.0, 5.0, 5.0]]])
+    f = np.vstack([faces[:6], faces[6:] + 8])
+    v2, f2 = geometry.clean(v, f)
+    assert (len(v2), len(f2)) == (8, 12) and watertight(v2, f2)
+
+
+# ------------------------------------------------------- areas, primitives
+
+@pytest.mark.parametrize("kind, kwargs", [
+    ("box", dict(size=[0.01, 0.02, 0.005])),
+    ("sphere", dict(radius=0.01, subdivisions=2)),
+    ("cylinder", dict(radius=0.01, height=0.03, sections=24)),
+])
+def test_primitives_closed_and_areas_sum(kind, kwargs):
+    vertices, faces = geometry.primitive(kind, **kwargs)
+    check_arrays(vertices, faces)
+    assert watertight(vertices, faces)
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    assert mesh.volume > 0                                       # outward winding
+    np.testing.assert_allclose(vertices.min(axis=0), -vertices.max(axis=0), atol=1e-15)
+    assert area(vertices, faces) == pytest.approx(mesh.area, rel=1e-12)
+    normals = geometry.vertex_normals(vertices, faces)
+    np.testing.assert_allclose(np.linalg.norm(normals, axis=1), 1.0, rtol=1e-12)
+    assert np.all(np.einsum("ij,ij->i", normals, vertices) > 0)  # outward for a convex body
+
+
+def test_primitive_arguments_checked():
+    with pytest.raises(ValueError, match="torus"):
+        geometry.primitive("torus", radius=1.0)
+    with pytest.raises(ValueError, match="radius"):
+        geometry.primitive("sphere")
+    with pytest.raises(ValueError, match="height"):
+        geometry.primitive("cylinder", radius=1.0, height=-1.0)
+
+
+def test_face_normals_unit_and_zero_for_zero_area():
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [2, 0, 0]], float)
+    faces = np.array([[0, 1, 2], [0, 1, 3]])
+    np.testing.assert_array_equal(geometry.face_normals(vertices, faces), [[0, 0, 1], [0, 0, 0]])
+
+
+# ---------------------------------------------------------- mass properties
+
+def test_box_mass_properties_closed_form():
+    a, b, c, rho = 0.02, 0.03, 0.05, 7850.0
+    vertices, faces = geometry.primitive("box", size=[a, b, c])
+    offset = np.array([1.0, -2.0, 3.0])
+    mass, com, inertia = geometry.mass_properties(vertices + offset, faces, density=rho)
+    m = rho * a * b * c
+    assert mass == pytest.approx(m, rel=1e-12)
+    np.testing.assert_allclose(com, offset, rtol=1e-12)
+    expected = m / 12 * np.diag([b * b + c * c, a * a + c * c, a * a + b * b])
+    np.testing.assert_allclose(inertia, expected, rtol=1e-9, atol=1e-12 * expected.max())
+
+    mass2, _, inertia2 = geometry.mass_properties(vertices, faces, mass=2.0)
+    assert mass2 == 2.0
+    np.testing.assert_allclose(inertia2, inertia * 2.0 / m, rtol=1e-12)
+
+
+def test_sphere_mass_properties_match_its_polyhedron():
+    radius, rho = 0.01, 1000.0
+    vertices, faces = geometry.primitive("sphere", radius=radius, subdivisions=3)
+    mass, com, inertia = geometry.mass_properties(vertices, faces, density=rho)
+    volume = trimesh.Trimesh(vertices, faces, process=False).volume
+    assert mass == pytest.approx(rho * volume, rel=1e-12)
+    np.testing.assert_allclose(com, 0.0, atol=1e-15)
+    # icosphere: isotropic within its discretisation, close to 2/5 m R²
+    np.testing.assert_allclose(np.diag(inertia), 0.4 * mass * radius ** 2, rtol=2e-2)
+    np.testing.assert_allclose(inertia - np.diag(np.diag(inertia)), 0.0, atol=1e-3 * inertia[0, 0])
+    assert volume == pytest.approx(4 / 3 * np.pi * radius ** 3, rel=2e-2)
+
+
+def test_mass_properties_refuses_open_and_accepts_inverted():
+    vertices, faces = geometry.primitive("box", size=1.0)
+    with pytest.raises(MeshError, match="open mesh.*closed mesh"):
+        geometry.mass_properties(vertices, faces[1:], density=1.0)
+    mass, com, inertia = geometry.mass_properties(vertices, faces[:, ::-1], density=1.0)
+    assert mass == pytest.approx(1.0) and inertia[0, 0] == pytest.approx(1 / 6)
+    with pytest.raises(ValueError, match="not both"):
+        geometry.mass_properties(vertices, faces, density=1.0, mass=1.0)
+
+
+def test_mesh_info(tmp_path):
+    path = tmp_path / "box.stl"
+    trimesh.creation.box(extents=[10.0, 20.0, 30.0]).export(path)
+    info = geometry.mesh_info(path, units="mm")
+    assert info["vertices"] == 8 and info["faces"] == 12 and info["watertight"]
+    np.testing.assert_allclose(info["extents"], [0.01, 0.02, 0.03])
+    assert info["volume"] == pytest.approx(6e-6) and info["area"] == pytest.approx(2.2e-3)
+    trimesh.Trimesh(*geometry.primitive("box", size=1.0), process=False).export(path)
+    mesh = trimesh.load(path, force="mesh")
+    trimesh.Trimesh(mesh.vertices, mesh.faces[1:]).export(path)
+    info = geometry.mesh_info(path)
+    assert not info["watertight"] and info["volume"] is None
+
+
+# --------------------------------------------------------------- refinement
+
+def test_refine_whole_box():
+    vertices, faces = geometry.primitive("box", size=[0.01, 0.02, 0.03])
+    v, f = geometry.refine(vertices, faces, 2e-3)
+    check_arrays(v, f)
+    assert edge_lengths(v, f).max() <= 2e-3
+    assert area(v, f) == pytest.approx(area(vertices, faces), rel=1e-12)
+    assert watertight(v, f)
+    # every new vertex lies on the box surface
+    assert np.all(np.isclose(np.abs(v), [0.005, 0.01, 0.015], rtol=0, atol=1e-15).any(axis=1))
+    assert trimesh.Trimesh(v, f, process=False).volume == pytest.approx(6e-6, rel=1e-12)
+
+
+def test_refine_bottom_only_stays_conforming():
+    vertices, faces = geometry.primitive("box", size=[0.01, 0.02, 0.03])
+    bottom = geometry.face_normals(vertices, faces)[:, 2] < -0.99
+    v, f = geometry.refine(vertices, faces, 1e-3, face_mask=bottom)
+    assert trimesh.Trimesh(v, f, process=False).is_watertight                  # no T-junctions
+    assert watertight(v, f)
+    on_bottom = np.all(np.isclose(v[f][:, :, 2], -0.015, rtol=0, atol=1e-15), axis=1)
+    assert edge_lengths(v, f[on_bottom]).max() <= 1e-3
+    assert area(v, f[on_bottom]) == pytest.approx(2e-4, rel=1e-12)
+    assert area(v, f) == pytest.approx(area(vertices, faces), rel=1e-12)
+    # the top is untouched, the sides only split where they meet the bottom
+    on_top = np.all(np.isclose(v[f][:, :, 2], 0.015, rtol=0, atol=1e-15), axis=1)
+    assert on_top.sum() == 2
+    assert (~on_bottom).sum() < on_bottom.sum()
+
+
+def test_refine_long_thin_triangles_economically():
+    # a CAD-style strip: two triangles of aspect ratio 100
+    length, width, resolution = 0.1, 1e-3, 2.5e-4
+    vertices = np.array([[0, 0, 0], [length, 0, 0], [length, width, 0], [0, width, 0]], float)
+    faces = np.array([[0, 1, 2], [0, 2, 3]])
+    v, f = geometry.refine(vertices, faces, resolution)
+    assert edge_lengths(v, f).max() <= resolution
+    assert area(v, f) == pytest.approx(length * width, rel=1e-12)
+    # right isosceles triangles with hypotenuse = resolution: area/(resolution²/4) faces;
+    # bisection may halve once more, and 4-way subdivision would need 2·4^9 ≈ 5e5
+    ideal = length * width / (resolution ** 2 / 4)
+    assert len(f) <= 2.5 * ideal
+    tri = v[f]
+    quality = (4 * np.sqrt(3) * geometry.tributary_areas(v, f).sum() / len(f)
+               / (edge_lengths(v, f) ** 2).sum(axis=1).mean())
+    assert quality > 0.5                                         # no slivers left, on average
+    assert np.all(np.abs(tri[:, :, 2]) == 0.0)
+    boundary = trimesh.Trimesh(v, f, process=False).outline()
+    assert len(boundary.entities) == 1                           # one open strip, no holes
+
+
+def test_refine_leaves_fine_meshes_alone_and_checks_inputs():
+    vertices, faces = geometry.primitive("sphere", radius=1.0, subdivisions=1)
+    v, f = geometry.refine(vertices, faces, 10.0)
+    np.testing.assert_array_equal(f, faces)
+    with pytest.raises(ValueError, match="resolution"):
+        geometry.refine(vertices, faces, 0.0)
+    with pytest.raises(ValueError, match="face_mask"):
+        geometry.refine(vertices, faces, 0.1, face_mask=np.ones(3, bool))
+    with pytest.raises(MeshError, match="more than 1000 faces"):
+        geometry.refine(vertices, faces, 1e-3, max_faces=1000)
+
+
+def test_refine_curved_surface_closed():
+    vertices, faces = geometry.primitive("cylinder", radius=0.01, height=0.05, sections=16)
+    v, f = geometry.refine(vertices, faces, 2e-3)
+    assert watertight(v, f) and edge_lengths(v, f).max() <= 2e-3
+    assert area(v, f) == pytest.approx(area(vertices, faces), rel=1e-12)
+
+
+# -------------------------------------------------------- inverted faces
+
+def test_inverted_faces_found():
+    vertices, faces = geometry.primitive("box", size=1.0)
+    vertices, faces = geometry.refine(vertices, faces, 0.3)
+    reference = geometry.face_normals(vertices, faces)
+    assert len(geometry.inverted_faces(reference, vertices, faces)) == 0
+    # drag one bottom vertex sideways past its neighbours: part of its fan flips
+    bottom = np.flatnonzero(np.isclose(vertices[:, 2], -0.5) & (np.abs(vertices[:, :2]).max(axis=1) < 0.45))
+    worn = vertices.copy()
+    worn[bottom[0], 0] += 0.6
+    flipped = geometry.inverted_faces(reference, worn, faces)
+    fan = np.flatnonzero((faces == bottom[0]).any(axis=1))
+    assert len(flipped) > 0 and set(flipped) <= set(fan)
+    # collapse: a face squashed to zero area is flagged too
+    squashed = vertices.copy()
+    a, b, c = faces[fan[0]]
+    squashed[c] = 0.5 * (squashed[a] + squashed[b])
+    assert fan[0] in geometry.inverted_faces(reference, squashed, faces)
+    reference_areas = trimesh.Trimesh(vertices, faces, process=False).area_faces
+    assert fan[0] in geometry.inverted_faces(reference, squashed, faces, reference_areas=reference_areas)
+    assert len(geometry.inverted_faces(reference, vertices, faces, reference_areas=reference_areas)) == 0
+
+
+def test_glb_scene_is_concatenated(tmp_path):
+    scene = trimesh.Scene()
+    scene.add_geometry(trimesh.creation.box(extents=[1.0, 1.0, 1.0]), node_name="a")
+    scene.add_geometry(trimesh.creation.box(extents=[1.0, 1.0, 1.0]), node_name="b",
+                       transform=trimesh.transformations.translation_matrix([3.0, 0.0, 0.0]))
+    path = tmp_path / "two.glb"
+    scene.export(path)
+    vertices, faces = geometry.load_mesh(path)
+    assert (len(vertices), len(faces)) == (16, 24) and watertight(vertices, faces)
+    np.testing.assert_allclose(np.ptp(vertices, axis=0), [4.0, 1.0, 1.0])

@@ -1,0 +1,147 @@
+"""Numba kernels against their plain-numpy twins (tests/reference.py): 1e-12 relative."""
+
+import numpy as np
+import pytest
+
+import reference
+from meshwear.kernels import contact, rigid
+
+RTOL = 1e-12
+
+
+def _random_case(rng, n, n_planes, wear_law, along_vertex_normal):
+    vertices = rng.uniform(-0.01, 0.01, (n, 3))
+    q = rng.normal(size=4)
+    pose = np.zeros(13)
+    pose[0:3] = [0.0, 0.0, 0.004]
+    pose[3:7] = q / np.linalg.norm(q)
+    pose[7:10] = rng.normal(scale=0.05, size=3)
+    pose[10:13] = rng.normal(scale=2.0, size=3)
+    planes = np.zeros((n_planes, 3, 3))
+    for s in range(n_planes):
+        normal = np.array([0.0, 0.0, 1.0]) + rng.normal(scale=0.3, size=3)
+        planes[s, 1] = normal / np.linalg.norm(normal)
+        planes[s, 0] = rng.normal(scale=0.002, size=3)
+        planes[s, 2] = rng.normal(scale=0.01, size=3)
+    params = rng.uniform(1e-6, 4e-6, n)
+    # per-point normal law, Winkler (per-area) tangential law: both paths covered
+    law = np.array([0.3, 0.4, wear_law, 1e-7, 1e-5, 5e4, 0.0, 2.0, 0.0, 0.0, 2e10, 0.0, 1e6])
+    if along_vertex_normal:
+        direction = rng.normal(size=(n, 3))
+        direction /= np.linalg.norm(direction, axis=1)[:, None]
+    else:
+        direction = np.zeros((0, 3))
+    arrays = dict(
+        contact_state=np.zeros((n_planes, n), np.int8),
+        tangential=np.zeros((n_planes, n, 4, 3)),
+        normal_force=np.zeros((n_planes, n)),
+        friction_work=np.zeros(n), wear_depth=np.zeros(n), wrench=np.zeros(6))
+    return vertices, pose, planes, params, law, direction, arrays
+
+
+def _call(fn, vertices, pose, planes, params, law, direction, a):
+    fn(vertices, pose, planes, params, law, direction, a["contact_state"], a["tangential"],
+       a["normal_force"], a["friction_work"], a["wear_depth"], a["wrench"])
+
+
+def _close(a, b):
+    scale = max(np.abs(b).max(), 1e-300)
+    return np.abs(a - b).max() <= RTOL * scale
+
+
+@pytest.mark.parametrize("kernel", [contact.plane_contact_serial, contact.plane_contact_parallel])
+@pytest.mark.parametrize("wear_law", [contact.ENERGY, contact.ENERGY_DENSITY, contact.ARCHARD])
+@pytest.mark.parametrize("along_vertex_normal", [False, True])
+def test_plane_contact_matches_numpy_twin(kernel, wear_law, along_vertex_normal):
+    rng = np.random.default_rng(7 + wear_law)
+    vertices, pose, planes, params, law, direction, arrays = _random_case(
+        rng, 400, 2, wear_law, along_vertex_normal)
+    twin_vertices = vertices.copy()
+    twin_arrays = {k: v.copy() for k, v in arrays.items()}
+    seen_states = set()
+    # a few steps with the pose wandering, so points enter, stick, slip, reverse and leave
+    for k in range(40):
+        pose[0:3] += 2e-4 * np.array([np.sin(k), np.cos(0.7 * k), np.sin(0.3 * k) - 0.2])
+        pose[7:10] = 0.05 * np.array([np.cos(0.9 * k), -np.sin(0.5 * k), 0.01])
+        _call(kernel, vertices, pose, planes, params, law, direction, arrays)
+        _call(reference.plane_contact, twin_vertices, pose, planes, params, law, direction, twin_arrays)
+        seen_states |= set(np.unique(arrays["contact_state"]).tolist())
+        for name in arrays:
+            assert _close(arrays[name], twin_arrays[name]), (k, name)
+        assert _close(vertices, twin_vertices), k
+    assert seen_states == {0, 1, 2}, "the case must exercise no contact, stick and slip"
+    assert arrays["wear_depth"].max() > 0.0
+
+
+def test_contact_state_machine_transitions():
+    """One point, one plane: stick on touch-down, slip past f0 N, stick on reversal."""
+    vertices = np.zeros((1, 3))
+    pose = np.zeros(13)
+    pose[3] = 1.0
+    pose[2] = -1e-6  # 1 µm penetration
+    planes = np.zeros((1, 3, 3))
+    planes[0, 1, 2] = 1.0
+    c = 1e6
+    params = np.array([1e-6])
+    law = np.array([0.5, 0.5, contact.ENERGY, 0.0, 1e-3, c, 0.0, 0.0, 0.0, c, 0.0, 0.0, 0.0])
+    a = dict(contact_state=np.zeros((1, 1), np.int8), tangential=np.zeros((1, 1, 4, 3)),
+             normal_force=np.zeros((1, 1)), friction_work=np.zeros(1), wear_depth=np.zeros(1),
+             wrench=np.zeros(6))
+    N = c * 1e-6
+    _call(contact.plane_contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
+    assert a["contact_state"][0, 0] == contact.STICK
+    assert a["normal_force"][0, 0] == pytest.approx(N)
+    # drag 0.4 µm: spring force 0.4 N < f0 N = 0.5 N, still stick, force continuous from F0 = 0
+    pose[0] = 0.4e-6
+    pose[7] = 1e-9
+    _call(contact.plane_contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
+    assert a["contact_state"][0, 0] == contact.STICK
+    assert a["tangential"][0, 0, 2, 0] == pytest.approx(-0.4, rel=1e-6)
+    # drag to 0.6 µm: past the static limit, slip with F = -f N along the slip velocity
+    pose[0] = 0.6e-6
+    _call(contact.plane_contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
+    assert a["contact_state"][0, 0] == contact.SLIP
+    assert a["tangential"][0, 0, 2, 0] == pytest.approx(-0.5)
+    # reverse: stick again, starting from the slip force (F0 = -0.5 N, no jump)
+    pose[7] = -1e-9
+    _call(contact.plane_contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
+    assert a["contact_state"][0, 0] == contact.STICK
+    assert a["tangential"][0, 0, 1, 0] == pytest.approx(-0.5)
+    # anchored one step back at the turning point: the spring already unloads
+    assert a["tangential"][0, 0, 2, 0] == pytest.approx(-0.5 + c * 1e-9 * 1e-3, rel=1e-9)
+    # lift off: no contact, no force
+    pose[2] = 1e-6
+    _call(contact.plane_contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
+    assert a["contact_state"][0, 0] == contact.NO_CONTACT
+    assert a["normal_force"][0, 0] == 0.0 and not a["tangential"][0, 0, 2].any()
+
+
+def test_free_step_matches_numpy_twin():
+    rng = np.random.default_rng(3)
+    A = rng.normal(size=(3, 3))
+    inertia = A @ A.T + 3 * np.eye(3)
+    inverse = np.linalg.inv(inertia)
+    pose = np.zeros(13)
+    q = rng.normal(size=4)
+    pose[3:7] = q / np.linalg.norm(q)
+    pose[7:13] = rng.normal(size=6)
+    twin = pose.copy()
+    for k in range(50):
+        wrench = rng.normal(size=6)
+        acc = np.array([0.0, 0.0, -9.81])
+        rigid.free_step(pose, wrench, 0.5, inertia, inverse, acc, 1e-3)
+        reference.free_step(twin, wrench, 0.5, inertia, inverse, acc, 1e-3)
+        assert _close(pose, twin), k
+
+
+def test_free_step_keeps_angular_momentum_without_torque():
+    inertia = np.diag([1.0, 2.0, 3.0])
+    pose = np.zeros(13)
+    pose[3] = 1.0
+    pose[10:13] = [1.0, 2.0, 0.5]
+    L0 = inertia @ pose[10:13]
+    for _ in range(2000):
+        rigid.free_step(pose, np.zeros(6), 1.0, inertia, np.linalg.inv(inertia), np.zeros(3), 1e-3)
+    R = reference.quaternion_matrix(pose[3:7])
+    L = R @ inertia @ R.T @ pose[10:13]
+    np.testing.assert_allclose(L, L0, rtol=1e-12, atol=1e-12)
