@@ -197,8 +197,9 @@ def _build_body(scene, index, body):
         vertices, faces = geometry.refine(vertices, faces, body.resolution)
     needs_inertia = body.motion in ("free", "guided")
     try:
-        mass, com, inertia = geometry.mass_properties(vertices, faces, density=body.density,
-                                                      mass=body.mass)
+        mass, com, inertia = geometry.mass_properties(
+            vertices, faces, density=body.density, mass=body.mass,
+            source=str(body.mesh) if body.mesh is not None else f"{key}.shape")
     except geometry.MeshError:
         if needs_inertia:
             raise
