@@ -222,7 +222,7 @@ def _build_body(scene, index, body):
     pose[10:13] = body.angular_velocity
     gravity = np.asarray(scene.run.gravity, float)
     acceleration = gravity + np.asarray(body.force, float) / mass if needs_inertia else gravity
-    path = Path(body.path) if body.path is not None else None
+    path = Path(body.path)
     if body.motion == "free":
         motion = FreeMotion(mass, inertia, acceleration)
     elif body.motion == "guided":
@@ -239,7 +239,7 @@ def _build_body(scene, index, body):
         wear_direction=wear_direction,
         reference_face_normals=geometry.face_normals(body_vertices, faces),
         mass=float(mass), inertia=inertia, origin=-com, initial_pose=pose, motion=motion,
-        period=path.period if path is not None else None)
+        period=path.period)
 
 
 def _pair(per_point, per_area):

@@ -16,60 +16,51 @@ Every motion implements
 
 import numpy as np
 
-from .kernels.rigid import axis_step, free_step
+from .kernels.rigid import (CIRCLE, OSCILLATION, STEADY, free_step, guided_step,
+                            path_point, place_on_path)
 
 
 class Path:
     """Displacement added to a body's initial position: oscillation, steady
-    velocity and circle, summed.
+    velocity and circle, summed (the ``terms`` rows of
+    :func:`meshwear.kernels.rigid.path_point`).
 
     Parameters
     ----------
-    config : meshwear.scene.PathConfig
+    config : meshwear.scene.PathConfig or None
+        None gives the empty path (no displacement).
     """
 
-    def __init__(self, config):
-        self.terms = []
-        if config.oscillation is not None:
+    def __init__(self, config=None):
+        rows = []
+        if config is not None and config.oscillation is not None:
             o = config.oscillation
-            self.terms.append(("oscillation", np.asarray(o.axis, float), o.amplitude,
-                               2.0 * np.pi * o.frequency))
-        if config.velocity is not None:
-            self.terms.append(("velocity", np.asarray(config.velocity, float), 0.0, 0.0))
-        if config.circle is not None:
+            rows.append([OSCILLATION, *o.axis, 0.0, 0.0, 0.0, o.amplitude, 2.0 * np.pi * o.frequency])
+        if config is not None and config.velocity is not None:
+            rows.append([STEADY, *config.velocity, 0.0, 0.0, 0.0, 0.0, 0.0])
+        if config is not None and config.circle is not None:
             c = config.circle
             normal = np.asarray(c.normal, float)
             e1 = _perpendicular(normal)
             e2 = np.cross(normal, e1)
-            self.terms.append(("circle", np.stack([e1, e2]), c.radius, 2.0 * np.pi * c.frequency))
-        frequencies = [t[3] / (2.0 * np.pi) for t in self.terms if t[3] > 0.0]
-        #: cycle length (s) of the periodic part, None for a steady path
-        self.period = 1.0 / min(frequencies) if frequencies else None
+            rows.append([CIRCLE, *e1, *e2, c.radius, 2.0 * np.pi * c.frequency])
+        #: (k, 9) float, see :func:`meshwear.kernels.rigid.path_point`
+        self.terms = np.array(rows, dtype=float).reshape(-1, 9)
+        omegas = self.terms[:, 8][self.terms[:, 8] > 0.0]
+        #: cycle length (s) of the slowest periodic term, None for a steady path
+        self.period = 2.0 * np.pi / omegas.min() if len(omegas) else None
+        self.buffer = np.zeros((2, 3))
 
     def displacement(self, t):
-        """(3,) displacement (m) at time ``t``; zero at ``t = 0`` except for a
-        circle, which starts at ``radius`` along its first in-plane axis."""
-        out = np.zeros(3)
-        for kind, vec, amplitude, omega in self.terms:
-            if kind == "oscillation":
-                out += amplitude * np.sin(omega * t) * vec
-            elif kind == "velocity":
-                out += t * vec
-            else:
-                out += amplitude * (np.cos(omega * t) * vec[0] + np.sin(omega * t) * vec[1])
-        return out
+        """(3,) displacement (m) at time ``t``. A circle starts at ``radius``
+        along its first in-plane axis: ``position`` is the circle's centre."""
+        path_point(self.terms, t, self.buffer)
+        return self.buffer[0].copy()
 
     def velocity(self, t):
         """(3,) velocity (m/s) at time ``t``."""
-        out = np.zeros(3)
-        for kind, vec, amplitude, omega in self.terms:
-            if kind == "oscillation":
-                out += amplitude * omega * np.cos(omega * t) * vec
-            elif kind == "velocity":
-                out += vec
-            else:
-                out += amplitude * omega * (-np.sin(omega * t) * vec[0] + np.cos(omega * t) * vec[1])
-        return out
+        path_point(self.terms, t, self.buffer)
+        return self.buffer[1].copy()
 
 
 def _perpendicular(normal):
@@ -102,18 +93,18 @@ class FreeMotion:
 
 
 class PrescribedMotion:
-    """All degrees of freedom follow ``start + path(t)``; orientation fixed."""
+    """All translations follow ``start + path(t)``; orientation fixed."""
 
     dynamic_axes = None
 
     def __init__(self, start, path):
         self.start = np.asarray(start, float)
         self.path = path
+        self.no_axis = np.zeros(3)
 
     def place(self, pose, t):
-        pose[0:3] = self.start + self.path.displacement(t)
-        pose[7:10] = self.path.velocity(t)
-        pose[10:13] = 0.0
+        place_on_path(pose, self.start, self.path.terms, self.no_axis, 0.0, 0.0, t,
+                      self.path.buffer)
 
     def advance(self, pose, wrench, t, dt):
         self.place(pose, t + dt)
@@ -128,24 +119,18 @@ class GuidedMotion:
 
     def __init__(self, start, path, free_axis, mass, acceleration):
         self.axis = np.asarray(free_axis, float)
-        self.across = np.eye(3) - np.outer(self.axis, self.axis)
         self.start = np.asarray(start, float)
         self.path = path
         self.inverse_mass = 1.0 / mass
         self.acceleration = np.asarray(acceleration, float)
 
     def place(self, pose, t):
-        along = pose[0:3] @ self.axis
-        rate = pose[7:10] @ self.axis
-        pose[0:3] = self.across @ (self.start + self.path.displacement(t)) + along * self.axis
-        pose[7:10] = self.across @ self.path.velocity(t) + rate * self.axis
-        pose[10:13] = 0.0
+        place_on_path(pose, self.start, self.path.terms, self.axis, pose[0:3] @ self.axis,
+                      pose[7:10] @ self.axis, t, self.path.buffer)
 
     def advance(self, pose, wrench, t, dt):
-        rate = axis_step(pose, wrench, self.inverse_mass, self.acceleration, self.axis, dt)
-        along = pose[0:3] @ self.axis + dt * rate
-        pose[0:3] = self.across @ (self.start + self.path.displacement(t + dt)) + along * self.axis
-        pose[7:10] = self.across @ self.path.velocity(t + dt) + rate * self.axis
+        guided_step(pose, wrench, self.inverse_mass, self.acceleration, self.axis, self.start,
+                    self.path.terms, t, dt, self.path.buffer)
 
 
 class FixedMotion:

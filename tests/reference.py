@@ -116,3 +116,29 @@ def free_step(pose, wrench, inverse_mass, inertia_body, inverse_inertia_body, ac
         pose[3:7] = q / np.linalg.norm(q)
     R = quaternion_matrix(pose[3:7])
     pose[10:13] = R @ inverse_inertia_body @ R.T @ L
+
+
+def path_point(terms, t):
+    """Displacement and velocity (2, 3) of the summed path terms at ``t``."""
+    out = np.zeros((2, 3))
+    for kind, ax, ay, az, bx, by, bz, amplitude, omega in terms:
+        a, b = np.array([ax, ay, az]), np.array([bx, by, bz])
+        if kind == 0:
+            out += [amplitude * np.sin(omega * t) * a, amplitude * omega * np.cos(omega * t) * a]
+        elif kind == 1:
+            out += [t * a, a]
+        else:
+            out += [amplitude * (np.cos(omega * t) * a + np.sin(omega * t) * b),
+                    amplitude * omega * (-np.sin(omega * t) * a + np.cos(omega * t) * b)]
+    return out
+
+
+def guided_step(pose, wrench, inverse_mass, acceleration, axis, start, terms, t, dt):
+    """Same contract as :func:`meshwear.kernels.rigid.guided_step`."""
+    rate = pose[7:10] @ axis + dt * (wrench[0:3] * inverse_mass + acceleration) @ axis
+    along = pose[0:3] @ axis + dt * rate
+    across = np.eye(3) - np.outer(axis, axis)
+    disp, vel = path_point(terms, t + dt)
+    pose[0:3] = across @ (start + disp) + along * axis
+    pose[7:10] = across @ vel + rate * axis
+    pose[10:13] = 0.0

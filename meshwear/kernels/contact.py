@@ -114,59 +114,65 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
             # point of the plane under A
             ax, ay, az = px - delta * nx, py - delta * ny, pz - delta * nz
             state = contact_state[s, i]
+            # friction state of the pair, in registers: stick anchor o, force
+            # when stick began h, friction force F, last slip velocity l
+            ox, oy, oz = tangential[s, i, 0, 0], tangential[s, i, 0, 1], tangential[s, i, 0, 2]
+            hx, hy, hz = tangential[s, i, 1, 0], tangential[s, i, 1, 1], tangential[s, i, 1, 2]
+            Fx, Fy, Fz = tangential[s, i, 2, 0], tangential[s, i, 2, 1], tangential[s, i, 2, 2]
+            lx, ly, lz = tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2]
             if state == NO_CONTACT:
                 # a new contact starts in stick with F0 = 0 at its position
                 state = STICK
-                tangential[s, i, 0, 0], tangential[s, i, 0, 1], tangential[s, i, 0, 2] = ax, ay, az
-                tangential[s, i, 1, 0] = tangential[s, i, 1, 1] = tangential[s, i, 1, 2] = 0.0
-                tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = sx, sy, sz
-            elif state == SLIP and sx * tangential[s, i, 3, 0] + sy * tangential[s, i, 3, 1] + sz * tangential[s, i, 3, 2] < 0.0:
+                ox, oy, oz = ax, ay, az
+                hx = hy = hz = 0.0
+                lx, ly, lz = sx, sy, sz
+            elif state == SLIP and sx * lx + sy * ly + sz * lz < 0.0:
                 # slip velocity reversed: stick from the turning point, one
                 # step back, with the force continuous (Jenkins element);
                 # anchoring here instead would leave |F| = f N at the limit
                 # and let any dip of N break the new stick at once
                 state = STICK
-                tangential[s, i, 0, 0] = ax - sx * dt
-                tangential[s, i, 0, 1] = ay - sy * dt
-                tangential[s, i, 0, 2] = az - sz * dt
-                tangential[s, i, 1, 0], tangential[s, i, 1, 1], tangential[s, i, 1, 2] = tangential[s, i, 2, 0], tangential[s, i, 2, 1], tangential[s, i, 2, 2]
-            speed = np.sqrt(sx * sx + sy * sy + sz * sz)
-            energy = 0.0
+                ox, oy, oz = ax - sx * dt, ay - sy * dt, az - sz * dt
+                hx, hy, hz = Fx, Fy, Fz
+            speed2 = sx * sx + sy * sy + sz * sz
+            speed = energy = 0.0
             if state == STICK:
                 # eq. 2, stick: F = F0 - c_t (r - r0) - d_t v, r - r0 in the plane
-                ex, ey, ez = ax - tangential[s, i, 0, 0], ay - tangential[s, i, 0, 1], az - tangential[s, i, 0, 2]
+                ex, ey, ez = ax - ox, ay - oy, az - oz
                 en = ex * nx + ey * ny + ez * nz
-                ex, ey, ez = ex - en * nx, ey - en * ny, ez - en * nz
-                Fx = tangential[s, i, 1, 0] - ct * ex - dtan * sx
-                Fy = tangential[s, i, 1, 1] - ct * ey - dtan * sy
-                Fz = tangential[s, i, 1, 2] - ct * ez - dtan * sz
+                Fx = hx - ct * (ex - en * nx) - dtan * sx
+                Fy = hy - ct * (ey - en * ny) - dtan * sy
+                Fz = hz - ct * (ez - en * nz) - dtan * sz
                 Fn = Fx * nx + Fy * ny + Fz * nz
                 Fx, Fy, Fz = Fx - Fn * nx, Fy - Fn * ny, Fz - Fn * nz
-                magnitude = np.sqrt(Fx * Fx + Fy * Fy + Fz * Fz)
-                if magnitude > f0 * load:
+                magnitude2 = Fx * Fx + Fy * Fy + Fz * Fz
+                limit = f0 * load
+                if magnitude2 > limit * limit:
                     # eq. 4: static limit exceeded, slip in the direction the
                     # spring was dragged (or of the slip velocity if any)
                     state = SLIP
-                    if speed == 0.0 and magnitude > 0.0:
-                        tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = -Fx, -Fy, -Fz
+                    if speed2 == 0.0:
+                        lx, ly, lz = -Fx, -Fy, -Fz
                 else:
-                    energy = dtan * speed * speed * dt
+                    energy = dtan * speed2 * dt
+            if speed2 > 0.0:
+                lx, ly, lz = sx, sy, sz
             if state == SLIP:
-                if speed > 0.0:
-                    tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = sx, sy, sz
                 # eq. 3: Coulomb slip force against the (last) slip direction
-                lx, ly, lz = tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2]
                 ll = np.sqrt(lx * lx + ly * ly + lz * lz)
                 if ll > 0.0:
                     scale = -f * load / ll
                     Fx, Fy, Fz = scale * lx, scale * ly, scale * lz
                 else:
                     Fx = Fy = Fz = 0.0
+                if speed2 > 0.0:
+                    speed = ll  # l = v here
                 energy = f * load * speed * dt
-            elif speed > 0.0:
-                tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = sx, sy, sz
             contact_state[s, i] = state
+            tangential[s, i, 0, 0], tangential[s, i, 0, 1], tangential[s, i, 0, 2] = ox, oy, oz
+            tangential[s, i, 1, 0], tangential[s, i, 1, 1], tangential[s, i, 1, 2] = hx, hy, hz
             tangential[s, i, 2, 0], tangential[s, i, 2, 1], tangential[s, i, 2, 2] = Fx, Fy, Fz
+            tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = lx, ly, lz
             # eq. 5 and variants: wear depth increment
             if wear_law == ENERGY:
                 dw = k * energy

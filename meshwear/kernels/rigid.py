@@ -94,21 +94,69 @@ def free_step(pose, wrench, inverse_mass, inertia_body, inverse_inertia_body,
     pose[10], pose[11], pose[12] = _rotate(r, bx, by, bz)
 
 
+#: path term kinds: rows of a (k, 9) ``terms`` array are
+#: ``[kind, a(3), b(3), amplitude, omega]``
+OSCILLATION, STEADY, CIRCLE = 0, 1, 2
+
+
 @njit(cache=True)
-def axis_step(pose, wrench, inverse_mass, acceleration, axis, dt):
-    """Advance the free translation of a guided body along ``axis`` by one step.
+def path_point(terms, t, out):
+    """Displacement (``out[0]``, m) and velocity (``out[1]``, m/s) of a path at ``t``.
 
-    Only the component of ``pose``'s velocity along the unit ``axis`` changes;
-    the caller sets the other components from the path.
+    Each row of ``terms`` adds one term: an oscillation ``A sin(omega t) a``,
+    a steady velocity ``t a``, or a circle ``R (cos(omega t) a + sin(omega t) b)``
+    (a, b orthonormal in the circle's plane).
+    """
+    for j in range(3):
+        out[0, j] = 0.0
+        out[1, j] = 0.0
+    for m in range(terms.shape[0]):
+        kind, amplitude, omega = int(terms[m, 0]), terms[m, 7], terms[m, 8]
+        for j in range(3):
+            a, b = terms[m, 1 + j], terms[m, 4 + j]
+            if kind == OSCILLATION:
+                out[0, j] += amplitude * np.sin(omega * t) * a
+                out[1, j] += amplitude * omega * np.cos(omega * t) * a
+            elif kind == STEADY:
+                out[0, j] += t * a
+                out[1, j] += a
+            else:
+                out[0, j] += amplitude * (np.cos(omega * t) * a + np.sin(omega * t) * b)
+                out[1, j] += amplitude * omega * (-np.sin(omega * t) * a + np.cos(omega * t) * b)
 
-    Returns
-    -------
-    float
-        The new velocity along ``axis`` (m/s), from the forces at the current
-        pose (the velocity half of the symplectic step).
+
+@njit(cache=True)
+def place_on_path(pose, start, terms, axis, along, rate, t, buffer):
+    """Put ``pose`` on its path at ``t``: ``start + path(t)`` across ``axis``,
+    ``along`` (m) and ``rate`` (m/s) along it. A zero ``axis`` prescribes every
+    translation. Rotation stays; angular velocity is zero."""
+    path_point(terms, t, buffer)
+    across = 0.0
+    speed = 0.0
+    for j in range(3):
+        across += (start[j] + buffer[0, j]) * axis[j]
+        speed += buffer[1, j] * axis[j]
+    for j in range(3):
+        pose[j] = start[j] + buffer[0, j] + (along - across) * axis[j]
+        pose[7 + j] = buffer[1, j] + (rate - speed) * axis[j]
+        pose[10 + j] = 0.0
+
+
+@njit(cache=True)
+def guided_step(pose, wrench, inverse_mass, acceleration, axis, start, terms, t, dt, buffer):
+    """Advance a guided body from ``t`` to ``t + dt``, in place.
+
+    The translation along the unit ``axis`` follows Newton's law under the
+    contact force, gravity and the applied force (symplectic Euler: velocity
+    first, then position with the new velocity); all else follows the path.
     """
     a = 0.0
+    rate = 0.0
+    along = 0.0
     for j in range(3):
         a += (wrench[j] * inverse_mass + acceleration[j]) * axis[j]
-    rate = pose[7] * axis[0] + pose[8] * axis[1] + pose[9] * axis[2] + dt * a
-    return rate
+        rate += pose[7 + j] * axis[j]
+        along += pose[j] * axis[j]
+    rate += dt * a
+    along += dt * rate
+    place_on_path(pose, start, terms, axis, along, rate, t + dt, buffer)
