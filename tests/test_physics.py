@@ -60,7 +60,7 @@ type = "plane"
 
 
 @pytest.mark.parametrize("amplitude", [5e-6, 2e-6])
-def test_reciprocating_block_dissipates_the_jenkins_loop(tmp_path, amplitude):
+def test_reciprocating_block_dissipates_the_jenkins_loop(tmp_path, amplitude, measured):
     scene = scene_file(tmp_path, JENKINS.format(amplitude=amplitude))
     model, state, history = run_scene(scene)
     h = history.rows["block"]
@@ -73,6 +73,7 @@ def test_reciprocating_block_dissipates_the_jenkins_loop(tmp_path, amplitude):
     for start in (0.1, 0.2):  # the first cycle loads the spring from zero: skip it
         i, j = np.searchsorted(t, [start - 1e-12, start + 0.1 - 1e-12])
         per_cycle = work[j] - work[i]
+        measured(f"energy/cycle from {start} s (J)", per_cycle, expected, 5e-3)
         assert per_cycle == pytest.approx(expected, rel=5e-3)
 
 
@@ -137,7 +138,7 @@ def block_scene(tmp_path, *, duration=0.3, dt=2e-5, history=301, f=0.3, f0=0.3, 
     return scene_file(tmp_path, text)
 
 
-def test_sliding_block_stops_after_the_coulomb_distance_and_stays(tmp_path):
+def test_sliding_block_stops_after_the_coulomb_distance_and_stays(tmp_path, measured):
     v0, mu = 0.5, 0.3
     scene = block_scene(tmp_path, duration=0.4, velocity=(v0, 0.0, 0.0), f=mu, f0=mu)
     model, state, history = run_scene(scene)
@@ -146,13 +147,14 @@ def test_sliding_block_stops_after_the_coulomb_distance_and_stays(tmp_path):
     expected = v0 ** 2 / (2 * mu * G)
     stop_time = v0 / (mu * G)
     stopped = h["time"] > stop_time + 0.05
+    measured("stopping distance (m)", x[stopped][0], expected, 1e-2)
     assert x[stopped][0] == pytest.approx(expected, rel=1e-2)
     # then it stays: no creep after it has stopped
     assert np.ptp(x[stopped]) < 1e-6
     assert np.abs(h["pose"][-1, 7:10]).max() < 1e-3
 
 
-def test_block_on_a_slope_below_static_friction_sticks(tmp_path):
+def test_block_on_a_slope_below_static_friction_sticks(tmp_path, measured):
     theta = np.radians(20.0)
     scene = block_scene(tmp_path, duration=1.2, dt=2e-5, history=121, f=0.5, f0=0.6, theta=theta)
     model, state, history = run_scene(scene)
@@ -161,11 +163,14 @@ def test_block_on_a_slope_below_static_friction_sticks(tmp_path):
     along = h["origin"] @ downhill
     settled = h["time"] >= 0.2 - 1e-12
     # drift over one second after the elastic settling
-    assert abs(along[settled][-1] - along[settled][0]) < 1e-6
+    drift = abs(along[settled][-1] - along[settled][0])
+    measured("drift over 1 s (m), tol abs", drift, 0.0, 1e-6)
+    assert drift < 1e-6
     assert np.abs(along - along[0]).max() < 2e-6  # the elastic deflection itself is tiny
 
 
-def test_block_on_a_slope_above_friction_slides_with_coulomb_acceleration(tmp_path):
+def test_block_on_a_slope_above_friction_slides_with_coulomb_acceleration(tmp_path, measured):
+    record = measured
     theta, mu = np.radians(20.0), 0.2
     scene = block_scene(tmp_path, duration=0.6, dt=2e-5, history=61, f=mu, f0=mu, theta=theta)
     model, state, history = run_scene(scene)
@@ -173,18 +178,20 @@ def test_block_on_a_slope_above_friction_slides_with_coulomb_acceleration(tmp_pa
     downhill = np.array([np.cos(theta), 0.0, -np.sin(theta)])
     speed = h["pose"][:, 7:10] @ downhill
     later = h["time"] >= 0.2 - 1e-12
-    measured = np.polyfit(h["time"][later], speed[later], 1)[0]
+    rate = np.polyfit(h["time"][later], speed[later], 1)[0]
     expected = G * (np.sin(theta) - mu * np.cos(theta))
-    assert measured == pytest.approx(expected, rel=1e-2)
+    record("acceleration (m/s²)", rate, expected, 1e-2)
+    assert rate == pytest.approx(expected, rel=1e-2)
 
 
-def test_energy_density_wear_volume_identity(tmp_path):
+def test_energy_density_wear_volume_identity(tmp_path, measured):
     k = 1e-13  # m³/J
     scene = block_scene(tmp_path, duration=0.2, velocity=(0.3, 0.1, 0.0), law="energy_density", k=k)
     model, state, history = run_scene(scene)
     s, body = state.bodies[0], model.bodies[0]
     volume = s.wear_depth @ body.tributary_area
     assert s.friction_work.sum() > 0.0
+    measured("wear volume (m³)", volume, k * s.friction_work.sum(), 1e-9)
     assert volume == pytest.approx(k * s.friction_work.sum(), rel=1e-9)
     h = history.rows["block"]
     assert np.all(np.diff(h["wear_depth"], axis=0) >= 0.0)

@@ -1,0 +1,157 @@
+"""Conforming refinement of triangle meshes (longest-edge bisection).
+
+Plain arrays in and out, as in :mod:`meshwear.geometry`, which re-exports
+:func:`refine`.
+"""
+
+import numpy as np
+
+from .geometry import MeshError, _arrays, _edge_keys, _edge_lengths
+
+
+def refine(vertices, faces, resolution, face_mask=None, max_faces=5_000_000):
+    """Split triangles until every edge of the selected faces is <= ``resolution``.
+
+    Conforming longest-edge bisection (Rivara): a face that needs refining has
+    its longest edge split; a face that shares a split edge has its own longest
+    edge split too (closure), then each face is cut along its split edges. No
+    T-junctions are left, so a closed mesh stays closed. After each pass,
+    Delaunay edge flips between coplanar selected faces keep the triangles well
+    shaped, so a long thin CAD triangle costs about what a well-shaped face of
+    the same area does. The surface itself never changes.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float
+    faces : (m, 3) int
+    resolution : float
+        Largest edge length allowed on selected faces (m).
+    face_mask : (m,) bool, optional
+        Faces to refine (default all). Children of selected faces stay selected;
+        unselected faces are split only where needed to stay conforming.
+    max_faces : int
+        Refuse (MeshError) rather than build a larger mesh.
+
+    Returns
+    -------
+    vertices : (k, 3) float
+    faces : (l, 3) int
+    """
+    V, F = _arrays(vertices, faces)
+    if not resolution > 0:
+        raise ValueError(f"resolution must be positive, got {resolution!r}")
+    mask = np.ones(len(F), bool) if face_mask is None else np.asarray(face_mask, bool).copy()
+    if mask.shape != (len(F),):
+        raise ValueError(f"face_mask has shape {mask.shape}, expected ({len(F)},)")
+    while True:
+        lengths = _edge_lengths(V, F)
+        need = mask & (lengths.max(axis=1) > resolution)
+        if not need.any():
+            return _arrays(V, F)
+        longest = lengths.argmax(axis=1)
+        edges, eid = np.unique(_edge_keys(F, len(V)), return_inverse=True)
+        eid = eid.reshape(-1, 3)
+        rows = np.arange(len(F))
+        marked = np.zeros(len(edges), bool)
+        marked[eid[need, longest[need]]] = True
+        while True:  # closure: a face with any split edge has its longest edge split too
+            bad = marked[eid].any(axis=1) & ~marked[eid[rows, longest]]
+            if not bad.any():
+                break
+            marked[eid[bad, longest[bad]]] = True
+        midpoint = np.full(len(edges), -1, np.int64)
+        midpoint[marked] = len(V) + np.arange(marked.sum())
+        ends = np.stack(np.divmod(edges[marked], len(V)), axis=1)
+        V = np.concatenate([V, 0.5 * (V[ends[:, 0]] + V[ends[:, 1]])])
+        F, mask, first_new = _bisect(F, mask, eid, midpoint, marked, longest)
+        active = np.zeros(len(F), bool)
+        active[first_new:] = True
+        F = _flip_coplanar(V, F, mask, active)
+        if len(F) > max_faces:
+            raise MeshError(f"refining to resolution {resolution:g} m needs more than {max_faces} faces")
+
+
+def _bisect(F, mask, eid, midpoint, marked, longest):
+    """Cut every face along its marked edges (the longest one first).
+
+    Returns the new faces, their mask and the index of the first new face
+    (uncut faces come first, unchanged).
+    """
+    rows = np.arange(len(F))
+    cut = marked[eid[rows, longest]]
+    k = longest[cut]
+    f, e = F[cut], eid[cut]
+    r = np.arange(len(f))
+    a, b, c = f[r, k], f[r, (k + 1) % 3], f[r, (k + 2) % 3]
+    m0 = midpoint[e[r, k]]
+    m1, m2 = midpoint[e[r, (k + 1) % 3]], midpoint[e[r, (k + 2) % 3]]
+    s1, s2 = m1 >= 0, m2 >= 0
+    children = [
+        np.stack([a, m0, c], axis=1)[~s2],            # (a, m0, c) kept whole
+        np.stack([m0, c, m2], axis=1)[s2],            # ... or cut on (c, a)
+        np.stack([m0, m2, a], axis=1)[s2],
+        np.stack([m0, b, c], axis=1)[~s1],            # (m0, b, c) kept whole
+        np.stack([m0, b, m1], axis=1)[s1],            # ... or cut on (b, c)
+        np.stack([m0, m1, c], axis=1)[s1],
+    ]
+    sel = mask[cut]
+    child_mask = [sel[~s2], sel[s2], sel[s2], sel[~s1], sel[s1], sel[s1]]
+    return (np.concatenate([F[~cut]] + children),
+            np.concatenate([mask[~cut]] + child_mask), int((~cut).sum()))
+
+
+def _flip_coplanar(V, F, mask, active, rounds=100):
+    """Delaunay edge flips between coplanar selected faces (the surface is unchanged).
+
+    Bisection alone keeps a thin triangle's children thin; flipping the shared
+    edge of two coplanar triangles whose opposite angles sum past pi restores
+    well-shaped triangles. Only edges of ``active`` (m,) bool faces are tested,
+    then those of the faces just flipped.
+    """
+    F = F.copy()
+    n = len(V)
+    for _ in range(rounds):
+        key = (F * n + np.roll(F, -1, axis=1)).ravel()            # directed edges
+        src = np.flatnonzero(np.repeat(active, 3) & (key // n < key % n))
+        order = np.argsort(key)
+        u, v = key[src] // n, key[src] % n
+        pos = np.minimum(np.searchsorted(key, v * n + u, sorter=order), len(key) - 1)
+        twin = order[pos]
+        ok = key[twin] == v * n + u
+        src, twin = src[ok], twin[ok]
+        # an edge (u < v) of an inactive face next to an active one: seen from the active side
+        back = np.flatnonzero(np.repeat(active, 3) & (key // n > key % n))
+        pos = np.minimum(np.searchsorted(key, (key[back] % n) * n + key[back] // n, sorter=order), len(key) - 1)
+        ok = (key[order[pos]] == (key[back] % n) * n + key[back] // n) & ~active[order[pos] // 3]
+        src, twin = np.concatenate([src, order[pos][ok]]), np.concatenate([twin, back[ok]])
+        f1, k1, f2, k2 = src // 3, src % 3, twin // 3, twin % 3
+        ok = mask[f1] & mask[f2] & (f1 != f2)
+        f1, k1, f2, k2 = f1[ok], k1[ok], f2[ok], k2[ok]
+        a, b = F[f1, k1], F[f1, (k1 + 1) % 3]
+        c, d = F[f1, (k1 + 2) % 3], F[f2, (k2 + 2) % 3]
+        t1, t2 = V[F[f1]], V[F[f2]]
+        n1 = np.cross(t1[:, 1] - t1[:, 0], t1[:, 2] - t1[:, 0])
+        n2 = np.cross(t2[:, 1] - t2[:, 0], t2[:, 2] - t2[:, 0])
+        coplanar = np.einsum("ij,ij->i", n1, n2) > (1.0 - 1e-12) * np.linalg.norm(n1, axis=1) * np.linalg.norm(n2, axis=1)
+        ca, cb, da, db = V[a] - V[c], V[b] - V[c], V[a] - V[d], V[b] - V[d]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cot_c = np.einsum("ij,ij->i", ca, cb) / np.linalg.norm(np.cross(ca, cb), axis=1)
+            cot_d = np.einsum("ij,ij->i", da, db) / np.linalg.norm(np.cross(da, db), axis=1)
+            badness = cot_c + cot_d                              # < 0: not Delaunay
+        flip = coplanar & (badness < -1e-9)
+        if flip.any():  # the new edge (c, d) must not exist already
+            flip &= ~np.isin(np.minimum(c, d) * n + np.maximum(c, d), _edge_keys(F, n))
+        if not flip.any():
+            return F
+        cand = np.flatnonzero(flip)[np.argsort(badness[flip])]  # worst first
+        idx = np.arange(len(cand))
+        owner = np.full(len(F), len(cand))
+        np.minimum.at(owner, f1[cand], idx)
+        np.minimum.at(owner, f2[cand], idx)
+        cand = cand[(owner[f1[cand]] == idx) & (owner[f2[cand]] == idx)]   # each face in one flip
+        F[f1[cand]] = np.stack([c[cand], a[cand], d[cand]], axis=1)
+        F[f2[cand]] = np.stack([d[cand], b[cand], c[cand]], axis=1)
+        active = np.zeros(len(F), bool)
+        active[f1[cand]] = True
+        active[f2[cand]] = True
+    return F
