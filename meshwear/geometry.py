@@ -266,7 +266,7 @@ def _edge_keys(F, n):
 
 
 # refinement lives in its own module; re-exported here as part of the API
-from .remesh import refine  # noqa: E402,F401
+from .remesh import refine  # noqa: E402,F401  (re-export)
 
 
 # ------------------------------------------------- areas, normals, checks

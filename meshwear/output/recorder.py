@@ -6,8 +6,6 @@ Physics never writes files; :func:`meshwear.simulate.run` calls
 
 from pathlib import Path
 
-import numpy as np
-
 from ..simulate import body_quantities
 from .tables import HISTORY_COLUMNS, HistoryWriter, write_json_atomic
 from .vtk import PVDSeries, plane_patch
