@@ -78,6 +78,9 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
     ct0, ct1, dt0, dt1 = law[9], law[10], law[11], law[12]
     along_vertex_normal = wear_direction.shape[0] == n_points
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
+    cx, cy, cz = pose[0], pose[1], pose[2]
+    vx, vy, vz = pose[7], pose[8], pose[9]
+    wx, wy, wz = pose[10], pose[11], pose[12]
     fx = fy = fz = tx = ty = tz = 0.0
     for i in prange(n_points):
         a = area[i]
@@ -87,10 +90,10 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
         rx = r00 * bx + r01 * by + r02 * bz
         ry = r10 * bx + r11 * by + r12 * bz
         rz = r20 * bx + r21 * by + r22 * bz
-        px, py, pz = pose[0] + rx, pose[1] + ry, pose[2] + rz
-        ux = pose[7] + pose[11] * rz - pose[12] * ry
-        uy = pose[8] + pose[12] * rx - pose[10] * rz
-        uz = pose[9] + pose[10] * ry - pose[11] * rx
+        px, py, pz = cx + rx, cy + ry, cz + rz
+        ux = vx + wy * rz - wz * ry
+        uy = vy + wz * rx - wx * rz
+        uz = vz + wx * ry - wy * rx
         for s in range(n_planes):
             nx, ny, nz = planes[s, 1, 0], planes[s, 1, 1], planes[s, 1, 2]
             # Delta = (x - p) . n, negative in penetration
@@ -114,65 +117,69 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
             # point of the plane under A
             ax, ay, az = px - delta * nx, py - delta * ny, pz - delta * nz
             state = contact_state[s, i]
-            # friction state of the pair, in registers: stick anchor o, force
-            # when stick began h, friction force F, last slip velocity l
-            ox, oy, oz = tangential[s, i, 0, 0], tangential[s, i, 0, 1], tangential[s, i, 0, 2]
-            hx, hy, hz = tangential[s, i, 1, 0], tangential[s, i, 1, 1], tangential[s, i, 1, 2]
-            Fx, Fy, Fz = tangential[s, i, 2, 0], tangential[s, i, 2, 1], tangential[s, i, 2, 2]
-            lx, ly, lz = tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2]
+            # friction state of the pair (tangential[s, i]): stick anchor o,
+            # force when stick began h, friction force F, last slip velocity l;
+            # read and written only where the state machine needs them
             if state == NO_CONTACT:
                 # a new contact starts in stick with F0 = 0 at its position
                 state = STICK
-                ox, oy, oz = ax, ay, az
-                hx = hy = hz = 0.0
-                lx, ly, lz = sx, sy, sz
-            elif state == SLIP and sx * lx + sy * ly + sz * lz < 0.0:
+                tangential[s, i, 0, 0], tangential[s, i, 0, 1], tangential[s, i, 0, 2] = ax, ay, az
+                tangential[s, i, 1, 0] = tangential[s, i, 1, 1] = tangential[s, i, 1, 2] = 0.0
+                tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = sx, sy, sz
+            elif state == SLIP and (sx * tangential[s, i, 3, 0] + sy * tangential[s, i, 3, 1]
+                                    + sz * tangential[s, i, 3, 2]) < 0.0:
                 # slip velocity reversed: stick from the turning point, one
                 # step back, with the force continuous (Jenkins element);
                 # anchoring here instead would leave |F| = f N at the limit
                 # and let any dip of N break the new stick at once
                 state = STICK
-                ox, oy, oz = ax - sx * dt, ay - sy * dt, az - sz * dt
-                hx, hy, hz = Fx, Fy, Fz
+                tangential[s, i, 0, 0] = ax - sx * dt
+                tangential[s, i, 0, 1] = ay - sy * dt
+                tangential[s, i, 0, 2] = az - sz * dt
+                for j in range(3):
+                    tangential[s, i, 1, j] = tangential[s, i, 2, j]
             speed2 = sx * sx + sy * sy + sz * sz
             speed = energy = 0.0
+            Fx = Fy = Fz = 0.0
             if state == STICK:
                 # eq. 2, stick: F = F0 - c_t (r - r0) - d_t v, r - r0 in the plane
-                ex, ey, ez = ax - ox, ay - oy, az - oz
+                ex = ax - tangential[s, i, 0, 0]
+                ey = ay - tangential[s, i, 0, 1]
+                ez = az - tangential[s, i, 0, 2]
                 en = ex * nx + ey * ny + ez * nz
-                Fx = hx - ct * (ex - en * nx) - dtan * sx
-                Fy = hy - ct * (ey - en * ny) - dtan * sy
-                Fz = hz - ct * (ez - en * nz) - dtan * sz
+                Fx = tangential[s, i, 1, 0] - ct * (ex - en * nx) - dtan * sx
+                Fy = tangential[s, i, 1, 1] - ct * (ey - en * ny) - dtan * sy
+                Fz = tangential[s, i, 1, 2] - ct * (ez - en * nz) - dtan * sz
                 Fn = Fx * nx + Fy * ny + Fz * nz
                 Fx, Fy, Fz = Fx - Fn * nx, Fy - Fn * ny, Fz - Fn * nz
-                magnitude2 = Fx * Fx + Fy * Fy + Fz * Fz
                 limit = f0 * load
-                if magnitude2 > limit * limit:
+                if Fx * Fx + Fy * Fy + Fz * Fz > limit * limit:
                     # eq. 4: static limit exceeded, slip in the direction the
                     # spring was dragged (or of the slip velocity if any)
                     state = SLIP
                     if speed2 == 0.0:
-                        lx, ly, lz = -Fx, -Fy, -Fz
+                        tangential[s, i, 3, 0] = -Fx
+                        tangential[s, i, 3, 1] = -Fy
+                        tangential[s, i, 3, 2] = -Fz
                 else:
                     energy = dtan * speed2 * dt
             if speed2 > 0.0:
-                lx, ly, lz = sx, sy, sz
+                tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = sx, sy, sz
             if state == SLIP:
                 # eq. 3: Coulomb slip force against the (last) slip direction
-                ll = np.sqrt(lx * lx + ly * ly + lz * lz)
+                if speed2 > 0.0:
+                    lx, ly, lz = sx, sy, sz
+                    speed = np.sqrt(speed2)
+                    ll = speed
+                else:
+                    lx, ly, lz = tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2]
+                    ll = np.sqrt(lx * lx + ly * ly + lz * lz)
                 if ll > 0.0:
                     scale = -f * load / ll
                     Fx, Fy, Fz = scale * lx, scale * ly, scale * lz
-                else:
-                    Fx = Fy = Fz = 0.0
-                if speed2 > 0.0:
-                    speed = ll  # l = v here
                 energy = f * load * speed * dt
             contact_state[s, i] = state
-            tangential[s, i, 0, 0], tangential[s, i, 0, 1], tangential[s, i, 0, 2] = ox, oy, oz
-            tangential[s, i, 1, 0], tangential[s, i, 1, 1], tangential[s, i, 1, 2] = hx, hy, hz
             tangential[s, i, 2, 0], tangential[s, i, 2, 1], tangential[s, i, 2, 2] = Fx, Fy, Fz
-            tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = lx, ly, lz
             # eq. 5 and variants: wear depth increment
             if wear_law == ENERGY:
                 dw = k * energy
