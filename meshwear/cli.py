@@ -83,7 +83,11 @@ def _run(scene_path, out, quiet):
     out_dir = Path(out) if out else Path("out") / Path(scene_path).stem
     timer = Timer()
     state = initial_state(model)
-    recorder = RunRecorder(out_dir, model)
+    try:
+        recorder = RunRecorder(out_dir, model)
+    except OSError as err:  # e.g. -o names an existing file, or a folder we may not write
+        raise InputError(f"{out_dir}: output folder: cannot write there "
+                         f"({err.strerror or err})") from None
     progress = None if quiet or not sys.stderr.isatty() else _ProgressBar(model)
     try:
         run(model, state, observers=[recorder], progress=progress)

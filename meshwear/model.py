@@ -152,7 +152,15 @@ def build_model(scene):
     run = scene.run
     n_steps = max(1, int(np.ceil(run.duration / run.dt - 1e-9)))
     dt = run.duration / n_steps
-    bodies = tuple(_build_body(scene, j, b) for j, b in enumerate(scene.bodies))
+    bodies = []
+    for j, b in enumerate(scene.bodies):
+        try:
+            bodies.append(_build_body(scene, j, b))
+        except geometry.MeshError as err:
+            # the mesh loader names the mesh file; add the scene file and the key
+            key = f"body[{j}].mesh" if b.mesh is not None else f"body[{j}].shape"
+            raise SceneError(scene.source, key, str(err)) from None
+    bodies = tuple(bodies)
     c = scene.contact
     tangential_stiffness = ((c.stiffness, c.stiffness_per_area)
                             if c.tangential_stiffness is None and c.tangential_stiffness_per_area is None

@@ -400,13 +400,24 @@ class Scene:
             fail("body", "no bodies; add at least one [[body]] table")
         items = ([(f"body[{i}]", b, BodyConfig) for i, b in enumerate(self.bodies)]
                  + [(f"surface[{j}]", s, SurfaceConfig) for j, s in enumerate(self.surfaces)])
-        seen = {}
+        # each name owns the output paths <name>.pvd and <name>/; no two may
+        # clash, nor with history.csv / summary.json, ignoring case (as
+        # Windows and macOS file systems do)
+        taken = {"history.csv": "history.csv", "summary.json": "summary.json"}
+        names = {}
         for key, item, cls in items:
             if not isinstance(item, cls):
                 fail(key, f"expected a {cls.__name__}, got {_show(item)}")
-            if item.name in seen:
-                fail(key + ".name", f"{item.name!r} is already the name of {seen[item.name]}")
-            seen[item.name] = key
+            if item.name in names:
+                fail(key + ".name", f"{item.name!r} is already the name of {names[item.name]}")
+            names[item.name] = key
+            paths = (item.name.casefold(), item.name.casefold() + ".pvd")
+            for path in paths:
+                if path in taken:
+                    fail(key + ".name", f"{item.name!r}: its output files would clash with "
+                         f"{taken[path]} (case is ignored); choose another name")
+            for path in paths:
+                taken[path] = f"those of {key}"
         if self.run.mode == "quasi-static":
             for i, b in enumerate(self.bodies):
                 if b.motion == "free":
