@@ -259,16 +259,18 @@ class EnergyProbe:
         self.energy.append(total)
 
 
-def test_tossed_cube_comes_to_rest_on_a_face(tmp_path):
+def test_tossed_cube_comes_to_rest_on_a_face(tmp_path, measured):
     scene = scene_file(tmp_path, CUBE.format(dt=5e-5))
     probe = EnergyProbe()
     model, state, history = run_scene(scene, observers=[probe])
     h = history.rows["cube"]
     pose = state.bodies[0].pose
+    measured("final speed (m/s), tol abs", np.linalg.norm(pose[7:10]), 0.0, 1e-3)
     assert np.linalg.norm(pose[7:10]) < 1e-3
     # tilt: the angle between some body axis and the floor normal
     R = np.array(rotation_entries(pose[3:7])).reshape(3, 3)
     tilt = np.degrees(np.arccos(min(1.0, np.abs(R[2]).max())))
+    measured("tilt (degrees), tol abs", tilt, 0.0, 2.0)
     assert tilt < 2.0
     # wear never decreases, per vertex
     assert np.all(np.diff(h["wear_depth"], axis=0) >= 0.0)
@@ -277,6 +279,7 @@ def test_tossed_cube_comes_to_rest_on_a_face(tmp_path):
     # integrator's O(dt) ripple, bounded here by 1% of the energy dissipated)
     e = np.asarray(probe.energy)
     rise = e[1:] - np.minimum.accumulate(e)[:-1]
+    measured("energy rise / dissipated", rise.max() / (e[0] - e[-1]), 0.0, 1e-2)
     assert rise.max() <= 1e-2 * (e[0] - e[-1])
 
 
