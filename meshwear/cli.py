@@ -91,6 +91,12 @@ def _run(scene_path, out, quiet):
     progress = None if quiet or not sys.stderr.isatty() else _ProgressBar(model)
     try:
         run(model, state, observers=[recorder], progress=progress)
+    except KeyboardInterrupt:
+        if progress:
+            progress.finish()
+        recorder.close(summary(model, state, timer.elapsed, "interrupted",
+                               f"interrupted at t = {state.time:.6g} s"))
+        raise
     except NumericalError as err:
         if progress:
             progress.finish()

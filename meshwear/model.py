@@ -137,6 +137,14 @@ def build_model(scene):
     SceneError, geometry.MeshError
         For input the engine cannot use, naming the key.
     """
+    # parts of format 1 that this version reads but cannot carry out yet are
+    # refused here, so no run silently does something other than asked
+    if scene.run.mode != "dynamic":
+        raise SceneError(scene.source, "run.mode", f"{scene.run.mode!r} is not supported by this "
+                         "version; use 'dynamic'")
+    if scene.wear.acceleration != "none":
+        raise SceneError(scene.source, "wear.acceleration", f"{scene.wear.acceleration!r} is not "
+                         "supported by this version; use 'none' (every cycle resolved)")
     planes = []
     for j, s in enumerate(scene.surfaces):
         if s.type != "plane":

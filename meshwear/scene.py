@@ -13,6 +13,7 @@ Keys of bodies and surfaces are written by index: ``body[0].density``,
 """
 
 import dataclasses
+import math
 import numbers
 import os
 import re
@@ -314,6 +315,16 @@ class BodyConfig:
         if self.motion == "prescribed" and self.path.free_axis is not None:
             raise SceneError("", "path.free_axis", "applies to guided bodies only; a "
                                                    "prescribed body follows its path exactly")
+        if self.motion == "guided":
+            if any(self.angular_velocity):
+                raise SceneError("", "angular_velocity", "does not apply to a guided body "
+                                                         "(it does not rotate)")
+            axis = self.path.free_axis
+            along = sum(v * a for v, a in zip(self.velocity, axis))
+            across = [v - along * a for v, a in zip(self.velocity, axis)]
+            if math.hypot(*across) > 1e-12 * max(1.0, math.hypot(*self.velocity)):
+                raise SceneError("", "velocity", "only its component along path.free_axis "
+                                                 "applies to a guided body (the path sets the rest)")
         if self.motion in ("prescribed", "fixed"):
             for key in ("velocity", "angular_velocity", "force"):
                 if any(getattr(self, key)):

@@ -58,7 +58,9 @@ def plane_contact(body_vertices, pose, planes, area, law, wear_direction,
         reversed_ = touching & (state == SLIP) & (_dot(slip_v, v_old) < 0.0)
         # stick starts at the turning point, one step back along the slip velocity
         anchor[reversed_] = on_plane[reversed_] - dt * slip_v[reversed_]
-        F0[reversed_] = F_old[reversed_]
+        # holding the slip force at the current load: F0 = -f N l/|l|
+        l_norm = np.linalg.norm(v_old[reversed_], axis=1)
+        F0[reversed_] = -(f * load[reversed_] / l_norm)[:, None] * v_old[reversed_]
         state[new | reversed_] = STICK
 
         speed = np.linalg.norm(slip_v, axis=1)
@@ -67,8 +69,10 @@ def plane_contact(body_vertices, pose, planes, area, law, wear_direction,
         trial = F0 - ct[:, None] * e - dtan[:, None] * slip_v
         trial -= np.outer(trial @ n, n)
         trial_mag = np.linalg.norm(trial, axis=1)
-        stick = touching & (state == STICK) & ~(trial_mag > f0 * load)
-        breaks = touching & (state == STICK) & (trial_mag > f0 * load)
+        # a point that reversed in this step keeps stick: its spring only unloads
+        exceeds = (trial_mag > f0 * load) & ~reversed_
+        stick = touching & (state == STICK) & ~exceeds
+        breaks = touching & (state == STICK) & exceeds
         v_old[breaks & (speed == 0.0)] = -trial[breaks & (speed == 0.0)]
         slip = touching & ((state == SLIP) | breaks)
         moving = touching & (speed > 0.0)

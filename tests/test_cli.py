@@ -260,6 +260,20 @@ BAD_SCENES = [
     ("cycle_jump_without_period", BASE.replace('coefficient = 1e-6', 'coefficient = 1e-6\nacceleration = "cycle_jump"'),
      {}, ["wear.period", "missing"]),
     ("no_bodies", BASE.split("[[body]]")[0], {}, ["body", "no bodies"]),
+    ("quasi_static_not_supported_yet",
+     BASE.replace("[run]", '[run]\nmode = "quasi-static"').replace(
+         "position = [0.0, 0.0, 0.0025]",
+         'position = [0.0, 0.0, 0.0025]\nmotion = "guided"\n'
+         'path = { velocity = [0.1, 0.0, 0.0], free_axis = [0.0, 0.0, 1.0] }'), {},
+     ["run.mode", "'quasi-static' is not supported"]),
+    ("cycle_jump_not_supported_yet",
+     BASE.replace('coefficient = 1e-6', 'coefficient = 1e-6\nacceleration = "cycle_jump"\nperiod = 0.1'),
+     {}, ["wear.acceleration", "'cycle_jump' is not supported"]),
+    ("guided_body_spinning",
+     BASE.replace("position = [0.0, 0.0, 0.0025]",
+                  'position = [0.0, 0.0, 0.0025]\nmotion = "guided"\nangular_velocity = [0.0, 0.0, 1.0]\n'
+                  'path = { velocity = [0.1, 0.0, 0.0], free_axis = [0.0, 0.0, 1.0] }'), {},
+     ["body[0].angular_velocity", "does not apply to a guided body"]),
     ("dt_above_stability_limit", BASE.replace("dt = 1e-5", "dt = 1e-3"), {},
      ["run.dt", "stability limit", "largest stable dt"]),
     ("mesh_surface_not_supported",

@@ -174,3 +174,48 @@ def test_guided_step_matches_numpy_twin():
                 + 0.01 * np.array([np.cos(3 * np.pi * t), np.sin(3 * np.pi * t), 0.0]))
     across = np.eye(3) - np.outer(axis, axis)
     np.testing.assert_allclose(across @ pose[0:3], across @ expected, rtol=0, atol=1e-15)
+
+
+def test_reversal_exactly_on_a_step_starts_stick_despite_a_dip_in_load():
+    """A turning point on a step leaves only round-off slip velocity; a round-off
+    dip of N must not break the new stick (it would skip a whole Jenkins branch)."""
+    vertices = np.zeros((1, 3))
+    pose = np.zeros(13)
+    pose[3] = 1.0
+    pose[2] = -1e-6
+    planes = np.zeros((1, 3, 3))
+    planes[0, 1, 2] = 1.0
+    c = 1e6
+    law = np.array([0.3, 0.3, contact.ENERGY, 0.0, 1e-5, c, 0.0, 0.0, 0.0, c, 0.0, 0.0, 0.0])
+    a = dict(contact_state=np.zeros((1, 1), np.int8), tangential=np.zeros((1, 1, 4, 3)),
+             normal_force=np.zeros((1, 1)), friction_work=np.zeros(1), wear_depth=np.zeros(1),
+             wrench=np.zeros(6))
+    args = (vertices, pose, planes, np.array([1e-6]), law, np.zeros((0, 3)))
+    # slide along +x until slipping
+    for k in range(10):
+        pose[0] = 1e-6 * k
+        pose[7] = 1e-3
+        _call(contact.plane_contact, *args, a)
+    assert a["contact_state"][0, 0] == contact.SLIP
+    # turning point: round-off velocity against the motion, and N a hair lower
+    pose[2] = -1e-6 * (1 - 1e-12)
+    pose[7] = -1e-20
+    _call(contact.plane_contact, *args, a)
+    assert a["contact_state"][0, 0] == contact.STICK
+    twin = {k: v.copy() for k, v in a.items()}
+    # and the twin agrees on the same step
+    a2 = dict(contact_state=np.zeros((1, 1), np.int8), tangential=np.zeros((1, 1, 4, 3)),
+              normal_force=np.zeros((1, 1)), friction_work=np.zeros(1), wear_depth=np.zeros(1),
+              wrench=np.zeros(6))
+    pose[2] = -1e-6
+    for k in range(10):
+        pose[0] = 1e-6 * k
+        pose[7] = 1e-3
+        _call(reference.plane_contact, vertices.copy(), pose, planes, np.array([1e-6]), law,
+              np.zeros((0, 3)), a2)
+    pose[2] = -1e-6 * (1 - 1e-12)
+    pose[7] = -1e-20
+    _call(reference.plane_contact, vertices.copy(), pose, planes, np.array([1e-6]), law,
+          np.zeros((0, 3)), a2)
+    assert a2["contact_state"][0, 0] == contact.STICK
+    assert _close(a2["tangential"], twin["tangential"])

@@ -117,6 +117,7 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
             # point of the plane under A
             ax, ay, az = px - delta * nx, py - delta * ny, pz - delta * nz
             state = contact_state[s, i]
+            reversed_now = False
             # friction state of the pair (tangential[s, i]): stick anchor o,
             # force when stick began h, friction force F, last slip velocity l;
             # read and written only where the state machine needs them
@@ -129,15 +130,22 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
             elif state == SLIP and (sx * tangential[s, i, 3, 0] + sy * tangential[s, i, 3, 1]
                                     + sz * tangential[s, i, 3, 2]) < 0.0:
                 # slip velocity reversed: stick from the turning point, one
-                # step back, with the force continuous (Jenkins element);
-                # anchoring here instead would leave |F| = f N at the limit
-                # and let any dip of N break the new stick at once
+                # step back, holding the slip force (Jenkins element: the
+                # force is continuous). F0 is that force at the current load,
+                # -f N l/|l|, and the spring only unloads from it, so this
+                # step keeps stick without a limit test: at a turning point
+                # that falls on a step the slip velocity is round-off, and a
+                # round-off excess of |F| over f0 N would skip a whole branch
                 state = STICK
+                reversed_now = True
                 tangential[s, i, 0, 0] = ax - sx * dt
                 tangential[s, i, 0, 1] = ay - sy * dt
                 tangential[s, i, 0, 2] = az - sz * dt
-                for j in range(3):
-                    tangential[s, i, 1, j] = tangential[s, i, 2, j]
+                lx, ly, lz = tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2]
+                scale = -f * load / np.sqrt(lx * lx + ly * ly + lz * lz)
+                tangential[s, i, 1, 0] = scale * lx
+                tangential[s, i, 1, 1] = scale * ly
+                tangential[s, i, 1, 2] = scale * lz
             speed2 = sx * sx + sy * sy + sz * sz
             speed = energy = 0.0
             Fx = Fy = Fz = 0.0
@@ -153,7 +161,7 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                 Fn = Fx * nx + Fy * ny + Fz * nz
                 Fx, Fy, Fz = Fx - Fn * nx, Fy - Fn * ny, Fz - Fn * nz
                 limit = f0 * load
-                if Fx * Fx + Fy * Fy + Fz * Fz > limit * limit:
+                if not reversed_now and Fx * Fx + Fy * Fy + Fz * Fz > limit * limit:
                     # eq. 4: static limit exceeded, slip in the direction the
                     # spring was dragged (or of the slip velocity if any)
                     state = SLIP
