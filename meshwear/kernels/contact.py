@@ -230,8 +230,15 @@ def _named_copy(fn, name):
     return copy
 
 
-plane_contact_serial = njit(cache=True)(_named_copy(_plane_contact, "plane_contact_serial"))
-plane_contact_parallel = njit(cache=True, parallel=True)(
+# fastmath "contract" only: lets LLVM fuse a*b + c into one FMA (one rounding
+# instead of two, +20% here). Results stay deterministic on a machine but may
+# differ in the last bits between CPUs with and without FMA; NaN and infinity
+# keep their IEEE meaning (no "nnan"/"ninf"), so non-finite states are still
+# caught downstream.
+_FLAGS = {"contract"}
+plane_contact_serial = njit(cache=True, fastmath=_FLAGS)(
+    _named_copy(_plane_contact, "plane_contact_serial"))
+plane_contact_parallel = njit(cache=True, parallel=True, fastmath=_FLAGS)(
     _named_copy(_plane_contact, "plane_contact_parallel"))
 
 
