@@ -13,6 +13,9 @@ import numpy as np
 
 log = logging.getLogger(__name__)
 
+#: file extensions read by trimesh; anything else goes to meshio (Gmsh .msh,
+#: Abaqus .inp, VTK .vtu/.vtk, ...)
+TRIMESH_FORMATS = {".stl", ".obj", ".ply", ".off", ".glb", ".gltf", ".3mf", ".dae", ".stl_ascii"}
 #: metres per unit of a mesh file
 UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "in": 0.0254}
 
@@ -59,18 +62,47 @@ def load_mesh(path, units="m"):
     scale = UNITS[units]
     if not path.is_file():
         raise MeshError(f"{path}: {'not a file' if path.exists() else 'mesh file not found'}")
-    import trimesh
-
     try:
-        mesh = trimesh.load(str(path), force="mesh", process=False)
-    except Exception as err:  # trimesh raises anything from KeyError to struct.error
+        if path.suffix.lower() in TRIMESH_FORMATS:
+            vertices, faces = _read_trimesh(path)
+        else:
+            vertices, faces = _read_meshio(path)
+    except MeshError:
+        raise
+    except Exception as err:  # readers raise anything from KeyError to struct.error
         reason = str(err).splitlines()[0] if str(err) else type(err).__name__
         raise MeshError(f"{path}: cannot read a mesh ({reason})") from None
-    vertices = np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64)
-    faces = np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64)
     if faces.size == 0 or vertices.size == 0:
         raise MeshError(f"{path}: no triangle faces found (empty, or not a mesh file)")
     return clean(vertices * scale, faces, source=str(path))
+
+
+def _read_trimesh(path):
+    import trimesh
+
+    mesh = trimesh.load(str(path), force="mesh", process=False)
+    return (np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64),
+            np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64))
+
+
+def _read_meshio(path):
+    """Surface triangles (quads split in two) of an FE mesh file read by meshio."""
+    import meshio
+
+    mesh = meshio.read(str(path))
+    faces = []
+    for block in mesh.cells:
+        if block.type == "triangle":
+            faces.append(block.data)
+        elif block.type == "quad":
+            q = block.data
+            faces += [q[:, [0, 1, 2]], q[:, [0, 2, 3]]]
+    if not faces:
+        kinds = ", ".join(sorted({b.type for b in mesh.cells})) or "none"
+        raise MeshError(f"{path}: no triangle or quad surface cells (cells: {kinds})")
+    return (np.asarray(mesh.points, dtype=np.float64)[:, :3] if mesh.points.shape[1] >= 3
+            else np.pad(np.asarray(mesh.points, float), ((0, 0), (0, 3 - mesh.points.shape[1]))),
+            np.concatenate(faces).astype(np.int64))
 
 
 def clean(vertices, faces, source="<mesh>"):

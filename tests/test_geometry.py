@@ -316,3 +316,16 @@ def test_glb_scene_is_concatenated(tmp_path):
     vertices, faces = geometry.load_mesh(path)
     assert (len(vertices), len(faces)) == (16, 24) and watertight(vertices, faces)
     np.testing.assert_allclose(np.ptp(vertices, axis=0), [4.0, 1.0, 1.0])
+
+
+@pytest.mark.parametrize("ext", ["vtu", "msh", "inp"])
+def test_fe_formats_load_through_meshio(tmp_path, ext):
+    """Gmsh, Abaqus and VTK surface meshes are read through trimesh's meshio bridge."""
+    import meshio
+
+    V, F = geometry.primitive("box", size=[10.0, 20.0, 30.0])
+    path = tmp_path / f"box.{ext}"
+    meshio.write(path, meshio.Mesh(V, [("triangle", F)]))
+    v, f = geometry.load_mesh(path, units="mm")
+    assert f.shape == (12, 3)
+    np.testing.assert_allclose(np.ptp(v, axis=0), [0.01, 0.02, 0.03], rtol=1e-12)
