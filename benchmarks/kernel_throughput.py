@@ -40,7 +40,10 @@ def make_case(n):
     planes[0, 1, 2] = 1.0
     params = np.full(n, 1e-8)  # tributary areas
     # Winkler contact: 1e12 N/m³ normal and tangential, light damping
-    law = np.array([0.3, 0.3, contact.ARCHARD, 1e-15, 1e-5, 0.0, 1e12, 0.0, 1e7, 0.0, 1e12, 0.0, 1e7])
+    law = contact.make_law(friction=0.3, static_friction=0.3, wear_law="archard",
+                           wear_coefficient=1e-15, dt=1e-5,
+                           stiffness_per_area=1e12, damping_per_area=1e7,
+                           tangential_stiffness_per_area=1e12, tangential_damping_per_area=1e7)
     state = dict(contact_state=np.zeros((1, n), np.int8), tangential=np.zeros((1, n, 4, 3)),
                  normal_force=np.zeros((1, n)), friction_work=np.zeros(n), wear_depth=np.zeros(n),
                  wrench=np.zeros(6))

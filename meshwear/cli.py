@@ -61,27 +61,22 @@ def main(argv=None):
 
 
 def _prepare(scene_path):
-    from .model import build_model, stable_time_step
+    from .model import build_model, check_time_step
     from .scene import load_scene
 
     scene = load_scene(scene_path)
     model = build_model(scene)
-    limit, who = stable_time_step(model)
-    if scene.run.dt > limit:
-        raise InputError(
-            f"{scene.source}: run.dt: {scene.run.dt:.3g} s is above the stability limit of the "
-            f"contact on body {who!r}; the largest stable dt is {limit:.3g} s")
-    return scene, model, limit
+    return scene, model, check_time_step(model)
 
 
 def _run(scene_path, out, quiet):
     from .model import initial_state
     from .output.recorder import RunRecorder, summary
-    from .simulate import NumericalError, Timer, run
+    from .simulate import NumericalError, run
 
     scene, model, _ = _prepare(scene_path)
     out_dir = Path(out) if out else Path("out") / Path(scene_path).stem
-    timer = Timer()
+    start = time.perf_counter()
     state = initial_state(model)
     try:
         recorder = RunRecorder(out_dir, model)
@@ -94,21 +89,28 @@ def _run(scene_path, out, quiet):
     except KeyboardInterrupt:
         if progress:
             progress.finish()
-        recorder.close(summary(model, state, timer.elapsed, "interrupted",
+        recorder.close(summary(model, state, time.perf_counter() - start, "interrupted",
                                f"interrupted at t = {state.time:.6g} s"))
         raise
+    except OSError as err:  # the disk filled up, or the folder went away, mid-run
+        if progress:
+            progress.finish()
+        raise InputError(f"{err.filename or out_dir}: cannot write the outputs "
+                         f"({err.strerror or err}); those written before t = {state.time:.6g} s "
+                         "are kept") from None
     except NumericalError as err:
         if progress:
             progress.finish()
-        recorder.close(summary(model, state, timer.elapsed, "numerical_error", str(err)))
+        recorder.close(summary(model, state, time.perf_counter() - start, "numerical_error", str(err)))
         print(f"meshwear: run stopped: {err}", file=sys.stderr)
         print(f"meshwear: outputs up to t = {state.time:.6g} s are in {out_dir}", file=sys.stderr)
         return EXIT_NUMERICAL
     if progress:
         progress.finish()
-    recorder.close(summary(model, state, timer.elapsed))
+    elapsed = time.perf_counter() - start
+    recorder.close(summary(model, state, elapsed))
     if not quiet:
-        print(f"done in {timer.elapsed:.1f} s: {model.n_steps} steps, "
+        print(f"done in {elapsed:.1f} s: {model.n_steps} steps, "
               f"{len(model.frame_steps)} frames")
         for body in model.bodies:
             print(f"  ParaView series: {out_dir / (body.name + '.pvd')}")
@@ -119,14 +121,17 @@ def _run(scene_path, out, quiet):
 
 
 def _check(scene_path):
+    import numpy as np
+
     from .model import initial_state
     from .simulate import step
 
     scene, model, limit = _prepare(scene_path)
     print(f"scene {scene.source}: ok (format 1, mode {scene.run.mode})")
     for b, config in zip(model.bodies, scene.bodies):
+        mass = f"{b.mass:.6g} kg" if np.isfinite(b.mass) else "n/a (open mesh, not integrated)"
         print(f"  body {b.name!r}: {len(b.tributary_area)} contact points, {len(b.faces)} faces, "
-              f"mass {b.mass:.6g} kg, motion {config.motion}")
+              f"mass {mass}, motion {config.motion}")
     for p in model.plane_list:
         print(f"  plane {p.name!r}: point {p.point.tolist()}, normal {p.normal.tolist()}")
     print(f"  dt {model.dt:.3g} s, largest stable dt {limit:.3g} s, {model.n_steps} steps, "
@@ -154,18 +159,23 @@ def _info(mesh_path, units):
 
 
 class _ProgressBar:
-    """One line on stderr, redrawn at every history sample."""
+    """One line on stderr, redrawn at most four times a second."""
 
     def __init__(self, model, width=30):
         self.model, self.width, self.start = model, width, time.perf_counter()
+        self.drawn = -1.0
 
     def __call__(self, step, n_steps):
+        now = time.perf_counter()
+        if now - self.drawn < 0.25 and step < n_steps:
+            return
+        self.drawn = now
         done = step / max(n_steps, 1)
-        elapsed = time.perf_counter() - self.start
-        eta = elapsed / done - elapsed if done > 0 else float("nan")
+        elapsed = now - self.start
+        eta = f"{elapsed / done - elapsed:5.0f} s" if done > 0 else "   -- s"
         bar = "#" * int(done * self.width)
-        sys.stderr.write(f"\r[{bar:<{self.width}}] {100 * done:5.1f}%  t = {step * self.model.dt:.4g} s"
-                         f"  eta {eta:5.0f} s ")
+        sys.stderr.write(f"\r[{bar:<{self.width}}] {100 * done:5.1f}%  "
+                         f"t = {step * self.model.dt:.4g} s  eta {eta} ")
         sys.stderr.flush()
 
     def finish(self):

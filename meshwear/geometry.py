@@ -61,7 +61,7 @@ def load_mesh(path, units="m"):
         raise MeshError(f"{path}: units {units!r}: expected one of {', '.join(UNITS)}")
     scale = UNITS[units]
     if not path.is_file():
-        raise MeshError(f"{path}: {'not a file' if path.exists() else 'mesh file not found'}")
+        raise MeshError(f"{path}: {_not_a_file(path)}")
     try:
         if path.suffix.lower() in TRIMESH_FORMATS:
             vertices, faces = _read_trimesh(path)
@@ -75,6 +75,13 @@ def load_mesh(path, units="m"):
     if faces.size == 0 or vertices.size == 0:
         raise MeshError(f"{path}: no triangle faces found (empty, or not a mesh file)")
     return clean(vertices * scale, faces, source=str(path))
+
+
+def _not_a_file(path):
+    """Why ``path``, which is not a regular file, cannot be read."""
+    if path.is_dir():
+        return "a folder, not a mesh file"
+    return "not a regular file" if path.exists() else "mesh file not found"
 
 
 def _read_trimesh(path):

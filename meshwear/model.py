@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import geometry
-from .kernels.contact import WEAR_LAWS, rotation_entries
+from .kernels.contact import make_law, rotation_entries
 from .motion import FixedMotion, FreeMotion, GuidedMotion, Path, PrescribedMotion
 from .scene import SceneError
 
@@ -160,6 +160,10 @@ def build_model(scene):
     run = scene.run
     n_steps = max(1, int(np.ceil(run.duration / run.dt - 1e-9)))
     dt = run.duration / n_steps
+    for key in ("frames", "history"):
+        if getattr(run, key) > n_steps + 1:
+            raise SceneError(scene.source, f"run.{key}", f"{getattr(run, key)} samples are more than "
+                             f"the {n_steps + 1} step times of the run (duration / dt + 1)")
     bodies = []
     for j, b in enumerate(scene.bodies):
         try:
@@ -170,16 +174,16 @@ def build_model(scene):
             raise SceneError(scene.source, key, str(err)) from None
     bodies = tuple(bodies)
     c = scene.contact
-    tangential_stiffness = ((c.stiffness, c.stiffness_per_area)
-                            if c.tangential_stiffness is None and c.tangential_stiffness_per_area is None
-                            else (c.tangential_stiffness, c.tangential_stiffness_per_area))
-    tangential_damping = ((c.damping, c.damping_per_area)
-                          if c.tangential_damping is None and c.tangential_damping_per_area is None
-                          else (c.tangential_damping, c.tangential_damping_per_area))
-    law = np.array([c.friction, c.static_friction, WEAR_LAWS[scene.wear.law], scene.wear.coefficient,
-                    dt, *_pair(c.stiffness, c.stiffness_per_area),
-                    *_pair(c.damping, c.damping_per_area), *_pair(*tangential_stiffness),
-                    *_pair(*tangential_damping)])
+    (ct, ct_area), (dt_point, dt_area) = c.tangential
+    law = make_law(friction=c.friction, static_friction=c.static_friction,
+                   wear_law=scene.wear.law, wear_coefficient=scene.wear.coefficient, dt=dt,
+                   stiffness=c.stiffness or 0.0, stiffness_per_area=c.stiffness_per_area or 0.0,
+                   damping=c.damping or 0.0, damping_per_area=c.damping_per_area or 0.0,
+                   tangential_stiffness=ct or 0.0, tangential_stiffness_per_area=ct_area or 0.0,
+                   tangential_damping=dt_point or 0.0,
+                   tangential_damping_per_area=dt_area or 0.0)
+    for j, (b, config) in enumerate(zip(bodies, scene.bodies)):
+        _refuse_deep_start(scene, j, b, config, planes)
     periods = [b.period for b in bodies if b.period is not None]
     period = scene.wear.period or (max(periods) if periods else None)
     # a plane without a size is drawn 4 body extents wide
@@ -212,6 +216,7 @@ def _build_body(scene, index, body):
     if body.resolution is not None:
         vertices, faces = geometry.refine(vertices, faces, body.resolution)
     needs_inertia = body.motion in ("free", "guided")
+    area = geometry.tributary_areas(vertices, faces)
     try:
         mass, com, inertia = geometry.mass_properties(
             vertices, faces, density=body.density, mass=body.mass,
@@ -219,9 +224,8 @@ def _build_body(scene, index, body):
     except geometry.MeshError:
         if needs_inertia:
             raise
-        area = geometry.tributary_areas(vertices, faces)
+        # an open mesh that is only moved: its area centroid stands in for the centre of mass
         mass, com, inertia = float("nan"), area @ vertices / area.sum(), np.full((3, 3), np.nan)
-    area = geometry.tributary_areas(vertices, faces)
     body_vertices = np.ascontiguousarray(vertices - com)
 
     if scene.wear.direction == "vertex_normal":
@@ -237,7 +241,11 @@ def _build_body(scene, index, body):
     pose[7:10] = body.velocity
     pose[10:13] = body.angular_velocity
     gravity = np.asarray(scene.run.gravity, float)
-    acceleration = gravity + np.asarray(body.force, float) / mass if needs_inertia else gravity
+    with np.errstate(over="ignore"):
+        acceleration = gravity + np.asarray(body.force, float) / mass if needs_inertia else gravity
+    if not np.all(np.isfinite(acceleration)):
+        raise SceneError(scene.source, f"{key}.force",
+                         f"{list(body.force)} N on {mass:.3g} kg overflows the acceleration")
     path = Path(body.path)
     if body.motion == "free":
         motion = FreeMotion(mass, inertia, acceleration)
@@ -258,15 +266,29 @@ def _build_body(scene, index, body):
         period=path.period)
 
 
-def _pair(per_point, per_area):
-    """(per point, per area) coefficients: c_i = c_point + c_area A_i."""
-    return (0.0, float(per_area)) if per_area is not None else (float(per_point or 0.0), 0.0)
+#: an initial penetration deeper than this fraction of the body's smallest
+#: extent is taken for a placing mistake (a static sink is microns at most)
+START_PENETRATION = 0.01
+
+
+def _refuse_deep_start(scene, index, body, config, planes):
+    """A body placed deep inside a plane would be shot out by its first steps."""
+    R = np.array(rotation_entries(body.initial_pose[3:7])).reshape(3, 3)
+    x = body.initial_pose[0:3] + body.reference_vertices @ R.T
+    allowed = START_PENETRATION * float(np.ptp(body.reference_vertices, axis=0).min())
+    for p in planes:
+        depth = -float(((x - p.point) @ p.normal).min())
+        if depth > allowed:
+            raise SceneError(scene.source, f"body[{index}].position",
+                             f"body {config.name!r} starts {depth:.3g} m inside surface "
+                             f"{p.name!r}; place it on or above the plane (its normal points "
+                             "out of the solid side)")
 
 
 def point_coefficients(model, body):
     """Per-vertex ``c, d, c_t, d_t`` (n,) of ``body`` (N/m, N·s/m)."""
     a = body.tributary_area
-    return tuple(model.law[5 + 2 * j] + model.law[6 + 2 * j] * a for j in range(4))
+    return tuple(model.law[5 + 2 * j] + model.law[6 + 2 * j] * a for j in range(4))  # LAW_SLOTS
 
 
 def initial_state(model):
@@ -287,8 +309,9 @@ def stable_time_step(model):
     """Largest stable time step (s) of the dynamic bodies, and the body that sets it.
 
     Bound: the contact stiffness of every vertex acting in all three directions
-    at once, ``K = sum_i max(c_i, c_t,i) J_i^T J_i`` with ``J_i = [I, -[r_i]x]``,
-    is at least the stiffness of any real contact configuration, so its largest
+    and against every plane at once, ``K = P sum_i max(c_i, c_t,i) J_i^T J_i``
+    with ``J_i = [I, -[r_i]x]`` and ``P`` planes, is at least the stiffness of
+    any real contact configuration, so its largest
     generalised eigenvalue against the mass matrix bounds the fastest contact
     mode, rotations included. Each mode ``omega`` with damping ratio ``zeta``
     is stable under the symplectic Euler step for
@@ -302,7 +325,9 @@ def stable_time_step(model):
         if kind is None:
             continue
         c, d, ct, dtan = point_coefficients(model, b)
-        k, d = np.maximum(c, ct), np.maximum(d, dtan)
+        # a vertex may press on every plane at once (a box in a corner)
+        planes = max(1, model.planes.shape[0])
+        k, d = planes * np.maximum(c, ct), planes * np.maximum(d, dtan)
         if kind == "axis":
             K = np.array([[k.sum()]])
             C = np.array([[d.sum()]])
@@ -316,6 +341,22 @@ def stable_time_step(model):
         if dt < best:
             best, who = dt, b.name
     return STABILITY_MARGIN * best, who
+
+
+def check_time_step(model):
+    """Refuse a ``run.dt`` above :func:`stable_time_step`; return the limit.
+
+    Raises
+    ------
+    SceneError
+        Naming ``run.dt`` and the largest stable dt.
+    """
+    limit, who = stable_time_step(model)
+    if model.scene.run.dt > limit:
+        raise SceneError(model.scene.source, "run.dt",
+                         f"{model.scene.run.dt:.3g} s is above the stability limit of the contact "
+                         f"on body {who!r}; the largest stable dt is {limit:.3g} s")
+    return limit
 
 
 def _contact_matrix(weights, r):

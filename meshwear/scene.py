@@ -53,7 +53,8 @@ def _check_mesh_or_shape(obj):
             raise SceneError("", "mesh", f"expected a file name, got {_show(obj.mesh)}")
         object.__setattr__(obj, "mesh", Path(obj.mesh))
         if not obj.mesh.is_file():
-            raise SceneError("", "mesh", f"file not found: {obj.mesh}")
+            why = "a folder, not a mesh file" if obj.mesh.is_dir() else "file not found"
+            raise SceneError("", "mesh", f"{why}: {obj.mesh}")
     else:
         _set(obj, "shape", _instance, ShapeConfig)
     _set(obj, "units", _choice, UNITS)

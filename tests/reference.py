@@ -51,7 +51,7 @@ def plane_contact(body_vertices, pose, planes, area, law, wear_direction,
         on_plane = x - np.outer(delta, n)
         T = tangential[s]
         state = contact_state[s].copy()
-        anchor, F0, F_old, v_old = T[:, 0].copy(), T[:, 1].copy(), T[:, 2].copy(), T[:, 3].copy()
+        anchor, F0, v_old = T[:, 0].copy(), T[:, 1].copy(), T[:, 3].copy()
 
         new = touching & (state == NO_CONTACT)
         anchor[new], F0[new], v_old[new] = on_plane[new], 0.0, slip_v[new]
@@ -89,13 +89,19 @@ def plane_contact(body_vertices, pose, planes, area, law, wear_direction,
         else:
             dw = np.where(slip, k * load / area * speed * dt, 0.0)
 
+        direction = wear_direction if wear_direction.shape[0] else np.tile(R.T @ n, (len(dw), 1))
+        if wear_direction.shape[0]:
+            # a sticking point's anchor follows its foot on the plane as it wears
+            along_plane = direction @ R.T
+            along_plane -= np.outer(along_plane @ n, n)
+            anchor += np.where(stick[:, None], dw[:, None] * along_plane, 0.0)
+
         contact_state[s] = np.where(touching, np.where(slip, SLIP, STICK), NO_CONTACT)
         normal_force[s] = load
         T[:, 0], T[:, 1], T[:, 3] = anchor, F0, v_old
         T[:, 2] = F
         friction_work += energy
         wear_depth += dw
-        direction = wear_direction if wear_direction.shape[0] else np.tile(R.T @ n, (len(dw), 1))
         moves += dw[:, None] * direction
         force += np.where(touching[:, None], load[:, None] * n + F, 0.0)
     body_vertices += moves

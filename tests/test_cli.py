@@ -274,11 +274,19 @@ BAD_SCENES = [
                   'position = [0.0, 0.0, 0.0025]\nmotion = "guided"\nangular_velocity = [0.0, 0.0, 1.0]\n'
                   'path = { velocity = [0.1, 0.0, 0.0], free_axis = [0.0, 0.0, 1.0] }'), {},
      ["body[0].angular_velocity", "does not apply to a guided body"]),
+    ("body_starts_inside_a_plane", BASE.replace("position = [0.0, 0.0, 0.0025]", "position = [0.0, 0.0, 0.001]"),
+     {}, ["body[0].position", "starts 0.0015 m inside surface 'floor'"]),
+    ("force_overflows", BASE.replace("position = [0.0, 0.0, 0.0025]",
+                                     "position = [0.0, 0.0, 0.0025]\nforce = [1e308, 0.0, 0.0]"),
+     {}, ["body[0].force", "overflows the acceleration"]),
+    ("more_frames_than_steps", BASE.replace("frames = 3", "frames = 5000"), {},
+     ["run.frames", "5000 samples are more than the 1001 step times"]),
     ("dt_above_stability_limit", BASE.replace("dt = 1e-5", "dt = 1e-3"), {},
      ["run.dt", "stability limit", "largest stable dt"]),
     ("mesh_surface_not_supported",
      BASE.replace('type = "plane"', 'type = "mesh"\nshape = { type = "box", size = [0.1, 0.1, 0.01] }'), {},
      ["surface[0].type", "not supported"]),
+    ("mesh_is_a_folder", with_mesh("."), {}, ["body[0].mesh", "a folder, not a mesh file"]),
     ("garbage_stl", with_mesh("garbage.stl"), {"garbage.stl": "solid x\nthis is not an stl file\n\x01\x02"},
      ["body[0].mesh", "garbage.stl", "no triangle faces"]),
     ("obj_with_nan_vertex", with_mesh("nan.obj"), {"nan.obj": NAN_OBJ},
@@ -550,6 +558,31 @@ def test_wear_through_the_thickness_stops_with_exit_3_and_valid_outputs(tmp_path
     assert all(b >= a for a, b in zip(wear, wear[1:]))
 
 
+def test_non_finite_state_stops_with_exit_3(tmp_path, capsys, caplog, monkeypatch):
+    """A state that turns NaN mid-run (injected after step 400 of 1000) stops the
+    run at the next sample with exit 3; the samples before it stay valid."""
+    import meshwear.simulate
+
+    real_step = meshwear.simulate.step
+
+    def step(model, state):
+        real_step(model, state)
+        if state.step == 400:
+            state.bodies[0].pose[7] = float("nan")
+
+    monkeypatch.setattr(meshwear.simulate, "step", step)
+    scene = write(tmp_path / "scene.toml", BASE)
+    out_dir = tmp_path / "out"
+    code, out, err = cli(capsys, caplog, "run", scene, "-o", out_dir, "-q")
+    assert code == 3, err
+    assert err[0].startswith("meshwear: run stopped: ") and "non-finite" in err[0], err
+    summary = json.loads((out_dir / "summary.json").read_text())
+    assert summary["status"] == "numerical_error" and summary["steps"] == 500
+    _, rows = read_history(out_dir / "history.csv")
+    assert [float(r["time"]) for r in rows] == pytest.approx([0.0, 0.0025])
+    assert all(math.isfinite(float(v)) for r in rows for k, v in r.items() if k != "body")
+
+
 # ------------------------------------------------------------------ check, info, demo
 
 def test_check_prints_the_cost_of_a_good_scene(tmp_path, capsys, caplog):
@@ -569,7 +602,7 @@ def test_check_accepts_an_open_mesh_for_a_fixed_body(tmp_path, capsys, caplog):
                                          'position = [0.0, 0.0, 0.001]\nmotion = "fixed"')
     code, out, err = cli(capsys, caplog, "check", write(tmp_path / "scene.toml", text))
     assert code == 0, err
-    assert "4 contact points" in out
+    assert "4 contact points" in out and "mass n/a" in out
 
 
 def test_info_describes_a_generated_stl(tmp_path, capsys, caplog):
@@ -622,3 +655,46 @@ def test_installed_command_refuses_a_bad_scene(tmp_path):
     assert "bad.toml" in lines[0] and "contact.fricton" in lines[0] and "friction" in lines[0]
     assert result.stdout == ""
     assert not (tmp_path / "out").exists()
+
+
+def test_progress_is_reported_between_sparse_samples(tmp_path):
+    from meshwear.model import build_model, initial_state
+    from meshwear.scene import load_scene
+    from meshwear.simulate import PROGRESS_STEPS, run
+
+    scene = write(tmp_path / "scene.toml", BASE.replace("history = 5", "history = 2").replace(
+        "duration = 0.01", "duration = 0.05"))
+    model = build_model(load_scene(scene))
+    calls = []
+    run(model, initial_state(model), progress=lambda step, n: calls.append((step, n)))
+    steps = [c[0] for c in calls]
+    assert steps == sorted(steps) and steps[-1] == model.n_steps
+    assert np.diff([0, *steps]).max() <= PROGRESS_STEPS
+    assert model.n_steps == 5000 and len(steps) >= 3
+
+
+def test_progress_bar_line(capsys):
+    from meshwear.cli import _ProgressBar
+
+    class Model:
+        dt = 1e-5
+
+    bar = _ProgressBar(Model())
+    bar(0, 1000)
+    bar(1000, 1000)
+    bar.finish()
+    err = capsys.readouterr().err
+    assert "eta    -- s" in err and "100.0%" in err and err.endswith("\n")
+
+
+def test_write_error_mid_run_is_one_line(tmp_path, capsys, caplog, monkeypatch):
+    from meshwear.output import recorder
+
+    def full_disk(self, model, state):
+        raise OSError(28, "No space left on device", str(tmp_path / "out" / "history.csv"))
+
+    monkeypatch.setattr(recorder.RunRecorder, "on_sample", full_disk)
+    code, out, err = cli(capsys, caplog, "run", write(tmp_path / "scene.toml", BASE),
+                         "-o", tmp_path / "out", "-q")
+    assert code == 2 and len(err) == 1, err
+    assert "history.csv: cannot write the outputs (No space left on device)" in err[0]

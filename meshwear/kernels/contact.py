@@ -54,6 +54,27 @@ NO_CONTACT, STICK, SLIP = 0, 1, 2
 ENERGY, ENERGY_DENSITY, ARCHARD = 0, 1, 2
 WEAR_LAWS = {"energy": ENERGY, "energy_density": ENERGY_DENSITY, "archard": ARCHARD}
 
+#: slots of ``tangential[s, i]``
+ANCHOR, START_FORCE, FORCE, SLIP_VELOCITY = 0, 1, 2, 3
+
+#: slots of ``law``, in order
+LAW_SLOTS = ("friction", "static_friction", "wear_law", "wear_coefficient", "dt",
+             "stiffness", "stiffness_per_area", "damping", "damping_per_area",
+             "tangential_stiffness", "tangential_stiffness_per_area",
+             "tangential_damping", "tangential_damping_per_area")
+
+
+def make_law(*, friction, static_friction, wear_law, wear_coefficient, dt,
+             stiffness=0.0, stiffness_per_area=0.0, damping=0.0, damping_per_area=0.0,
+             tangential_stiffness=0.0, tangential_stiffness_per_area=0.0,
+             tangential_damping=0.0, tangential_damping_per_area=0.0):
+    """The ``law`` array of the kernel from named values (``wear_law``: a code
+    of :data:`WEAR_LAWS` or its name)."""
+    if isinstance(wear_law, str):
+        wear_law = WEAR_LAWS[wear_law]
+    values = dict(locals())
+    return np.array([float(values[name]) for name in LAW_SLOTS])
+
 # Pairs with at least this many vertex-plane pairs use the threaded kernel;
 # below it thread start-up costs more than the work.
 PARALLEL_THRESHOLD = 4096
@@ -103,7 +124,7 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                 contact_state[s, i] = NO_CONTACT
                 normal_force[s, i] = 0.0
                 for j in range(3):
-                    tangential[s, i, 2, j] = 0.0
+                    tangential[s, i, FORCE, j] = 0.0
                 continue
             # velocity of A relative to the plane: normal rate and slip velocity
             gx, gy, gz = ux - planes[s, 2, 0], uy - planes[s, 2, 1], uz - planes[s, 2, 2]
@@ -124,11 +145,17 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
             if state == NO_CONTACT:
                 # a new contact starts in stick with F0 = 0 at its position
                 state = STICK
-                tangential[s, i, 0, 0], tangential[s, i, 0, 1], tangential[s, i, 0, 2] = ax, ay, az
-                tangential[s, i, 1, 0] = tangential[s, i, 1, 1] = tangential[s, i, 1, 2] = 0.0
-                tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = sx, sy, sz
-            elif state == SLIP and (sx * tangential[s, i, 3, 0] + sy * tangential[s, i, 3, 1]
-                                    + sz * tangential[s, i, 3, 2]) < 0.0:
+                tangential[s, i, ANCHOR, 0] = ax
+                tangential[s, i, ANCHOR, 1] = ay
+                tangential[s, i, ANCHOR, 2] = az
+                for j in range(3):
+                    tangential[s, i, START_FORCE, j] = 0.0
+                tangential[s, i, SLIP_VELOCITY, 0] = sx
+                tangential[s, i, SLIP_VELOCITY, 1] = sy
+                tangential[s, i, SLIP_VELOCITY, 2] = sz
+            elif state == SLIP and (sx * tangential[s, i, SLIP_VELOCITY, 0]
+                                    + sy * tangential[s, i, SLIP_VELOCITY, 1]
+                                    + sz * tangential[s, i, SLIP_VELOCITY, 2]) < 0.0:
                 # slip velocity reversed: stick from the turning point, one
                 # step back, holding the slip force (Jenkins element: the
                 # force is continuous). F0 is that force at the current load,
@@ -138,26 +165,28 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                 # round-off excess of |F| over f0 N would skip a whole branch
                 state = STICK
                 reversed_now = True
-                tangential[s, i, 0, 0] = ax - sx * dt
-                tangential[s, i, 0, 1] = ay - sy * dt
-                tangential[s, i, 0, 2] = az - sz * dt
-                lx, ly, lz = tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2]
+                tangential[s, i, ANCHOR, 0] = ax - sx * dt
+                tangential[s, i, ANCHOR, 1] = ay - sy * dt
+                tangential[s, i, ANCHOR, 2] = az - sz * dt
+                lx = tangential[s, i, SLIP_VELOCITY, 0]
+                ly = tangential[s, i, SLIP_VELOCITY, 1]
+                lz = tangential[s, i, SLIP_VELOCITY, 2]
                 scale = -f * load / np.sqrt(lx * lx + ly * ly + lz * lz)
-                tangential[s, i, 1, 0] = scale * lx
-                tangential[s, i, 1, 1] = scale * ly
-                tangential[s, i, 1, 2] = scale * lz
+                tangential[s, i, START_FORCE, 0] = scale * lx
+                tangential[s, i, START_FORCE, 1] = scale * ly
+                tangential[s, i, START_FORCE, 2] = scale * lz
             speed2 = sx * sx + sy * sy + sz * sz
             speed = energy = 0.0
             Fx = Fy = Fz = 0.0
             if state == STICK:
                 # eq. 2, stick: F = F0 - c_t (r - r0) - d_t v, r - r0 in the plane
-                ex = ax - tangential[s, i, 0, 0]
-                ey = ay - tangential[s, i, 0, 1]
-                ez = az - tangential[s, i, 0, 2]
+                ex = ax - tangential[s, i, ANCHOR, 0]
+                ey = ay - tangential[s, i, ANCHOR, 1]
+                ez = az - tangential[s, i, ANCHOR, 2]
                 en = ex * nx + ey * ny + ez * nz
-                Fx = tangential[s, i, 1, 0] - ct * (ex - en * nx) - dtan * sx
-                Fy = tangential[s, i, 1, 1] - ct * (ey - en * ny) - dtan * sy
-                Fz = tangential[s, i, 1, 2] - ct * (ez - en * nz) - dtan * sz
+                Fx = tangential[s, i, START_FORCE, 0] - ct * (ex - en * nx) - dtan * sx
+                Fy = tangential[s, i, START_FORCE, 1] - ct * (ey - en * ny) - dtan * sy
+                Fz = tangential[s, i, START_FORCE, 2] - ct * (ez - en * nz) - dtan * sz
                 Fn = Fx * nx + Fy * ny + Fz * nz
                 Fx, Fy, Fz = Fx - Fn * nx, Fy - Fn * ny, Fz - Fn * nz
                 limit = f0 * load
@@ -166,13 +195,15 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                     # spring was dragged (or of the slip velocity if any)
                     state = SLIP
                     if speed2 == 0.0:
-                        tangential[s, i, 3, 0] = -Fx
-                        tangential[s, i, 3, 1] = -Fy
-                        tangential[s, i, 3, 2] = -Fz
+                        tangential[s, i, SLIP_VELOCITY, 0] = -Fx
+                        tangential[s, i, SLIP_VELOCITY, 1] = -Fy
+                        tangential[s, i, SLIP_VELOCITY, 2] = -Fz
                 else:
                     energy = dtan * speed2 * dt
             if speed2 > 0.0:
-                tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2] = sx, sy, sz
+                tangential[s, i, SLIP_VELOCITY, 0] = sx
+                tangential[s, i, SLIP_VELOCITY, 1] = sy
+                tangential[s, i, SLIP_VELOCITY, 2] = sz
             if state == SLIP:
                 # eq. 3: Coulomb slip force against the (last) slip direction
                 if speed2 > 0.0:
@@ -180,14 +211,16 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                     speed = np.sqrt(speed2)
                     ll = speed
                 else:
-                    lx, ly, lz = tangential[s, i, 3, 0], tangential[s, i, 3, 1], tangential[s, i, 3, 2]
+                    lx = tangential[s, i, SLIP_VELOCITY, 0]
+                    ly = tangential[s, i, SLIP_VELOCITY, 1]
+                    lz = tangential[s, i, SLIP_VELOCITY, 2]
                     ll = np.sqrt(lx * lx + ly * ly + lz * lz)
                 if ll > 0.0:
                     scale = -f * load / ll
                     Fx, Fy, Fz = scale * lx, scale * ly, scale * lz
                 energy = f * load * speed * dt
             contact_state[s, i] = state
-            tangential[s, i, 2, 0], tangential[s, i, 2, 1], tangential[s, i, 2, 2] = Fx, Fy, Fz
+            tangential[s, i, FORCE, 0], tangential[s, i, FORCE, 1], tangential[s, i, FORCE, 2] = Fx, Fy, Fz
             # eq. 5 and variants: wear depth increment
             if wear_law == ENERGY:
                 dw = k * energy
@@ -203,6 +236,17 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                 # geometry update: into the body along +n, in the body frame
                 if along_vertex_normal:
                     mx, my, mz = wear_direction[i, 0], wear_direction[i, 1], wear_direction[i, 2]
+                    if state == STICK:
+                        # the vertex's foot on the plane moves with the part of
+                        # the wear step along the plane: move the anchor with
+                        # it, so wear does not load the stick spring
+                        hx = r00 * mx + r01 * my + r02 * mz
+                        hy = r10 * mx + r11 * my + r12 * mz
+                        hz = r20 * mx + r21 * my + r22 * mz
+                        hn = hx * nx + hy * ny + hz * nz
+                        tangential[s, i, ANCHOR, 0] += dw * (hx - hn * nx)
+                        tangential[s, i, ANCHOR, 1] += dw * (hy - hn * ny)
+                        tangential[s, i, ANCHOR, 2] += dw * (hz - hn * nz)
                 else:
                     mx = r00 * nx + r10 * ny + r20 * nz
                     my = r01 * nx + r11 * ny + r21 * nz

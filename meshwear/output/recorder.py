@@ -6,7 +6,7 @@ Physics never writes files; :func:`meshwear.simulate.run` calls
 
 from pathlib import Path
 
-from ..simulate import body_quantities
+from .fields import body_quantities
 from .tables import HISTORY_COLUMNS, HistoryWriter, write_json_atomic
 from .vtk import PVDSeries, plane_patch
 

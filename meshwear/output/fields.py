@@ -1,0 +1,33 @@
+"""Per-vertex fields and per-body totals of a state, as recorders write them."""
+
+import numpy as np
+
+from ..kernels.contact import FORCE, rotation_entries
+
+
+def body_quantities(body, s):
+    """Per-vertex fields and totals of one body, for recorders.
+
+    Returns
+    -------
+    dict
+        ``points`` (n, 3) world positions, the point-data fields of DESIGN.md
+        §5 and the history totals.
+    """
+    R = np.array(rotation_entries(s.pose[3:7])).reshape(3, 3)
+    normal_force = s.normal_force.sum(axis=0)
+    friction_force = s.tangential[:, :, FORCE, :].sum(axis=0)
+    return {
+        "points": s.pose[0:3] + s.vertices @ R.T,
+        "origin": s.pose[0:3] + R @ body.origin,
+        "wear_depth": s.wear_depth,
+        "normal_force": normal_force,
+        "friction_force": friction_force,
+        "pressure": normal_force / body.tributary_area,
+        "contact_state": (s.contact_state.max(axis=0) if s.contact_state.shape[0]
+                          else np.zeros(len(s.wear_depth), np.int8)).astype(np.int32),
+        "friction_work": s.friction_work,
+        "wear_volume": float(s.wear_depth @ body.tributary_area),
+        "max_wear_depth": float(s.wear_depth.max()),
+        "total_friction_work": float(s.friction_work.sum()),
+    }
