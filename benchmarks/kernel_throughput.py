@@ -38,7 +38,8 @@ def make_case(n):
     pose[2] = -1e-6
     planes = np.zeros((1, 3, 3))
     planes[0, 1, 2] = 1.0
-    params = np.full(n, 1e-8)  # tributary areas
+    params = np.zeros((n, 4))  # area vectors: 0.01 mm² each, facing the plane
+    params[:, 2], params[:, 3] = -1e-8, 1e-8
     # Winkler contact: 1e12 N/m³ normal and tangential, light damping
     law = contact.make_law(friction=0.3, static_friction=0.3, wear_law="archard",
                            wear_coefficient=1e-15, dt=1e-5,
@@ -46,7 +47,7 @@ def make_case(n):
                            tangential_stiffness_per_area=1e12, tangential_damping_per_area=1e7)
     state = dict(contact_state=np.zeros((1, n), np.int8), tangential=np.zeros((1, n, 4, 3)),
                  normal_force=np.zeros((1, n)), friction_work=np.zeros(n), wear_depth=np.zeros(n),
-                 wrench=np.zeros(6))
+                 wear_volume=np.zeros(n), wrench=np.zeros(6))
     return vertices, pose, planes, params, law, np.zeros((0, 3)), state
 
 
@@ -59,7 +60,7 @@ def drive(kernel, case, steps):
         pose[0] = 2e-6 * np.sin(phase)
         pose[7] = 2e-6 * 2 * np.pi / (200 * 1e-5) * np.cos(phase)
         kernel(vertices, pose, planes, params, law, direction, s["contact_state"], s["tangential"],
-               s["normal_force"], s["friction_work"], s["wear_depth"], s["wrench"])
+               s["normal_force"], s["friction_work"], s["wear_depth"], s["wear_volume"], s["wrench"])
     return time.perf_counter() - start
 
 

@@ -317,6 +317,24 @@ def tributary_areas(vertices, faces):
     return np.bincount(F.ravel(), weights=np.repeat(third, 3), minlength=len(V))
 
 
+def area_vectors(vertices, faces):
+    """(n, 4) float: each vertex's area vector (m²): a third of each adjacent
+    face's area times its outward unit normal, summed; then its length.
+
+    Projected on a direction ``-n``, the vector gives the vertex's share of
+    the surface's projection on a plane of normal ``n``: its contact area
+    there. Its length is at most the tributary area.
+    """
+    V, F = _arrays(vertices, faces)
+    tri = V[F]
+    third = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]) / 6.0   # area/3 · normal
+    out = np.zeros((len(V), 4))
+    for k in range(3):
+        out[:, k] = np.bincount(F.ravel(), weights=np.repeat(third[:, k], 3), minlength=len(V))
+    out[:, 3] = np.linalg.norm(out[:, 0:3], axis=1)
+    return out
+
+
 def face_normals(vertices, faces):
     """(m, 3) float: unit outward face normals; zero-area faces give zeros."""
     V, F = _arrays(vertices, faces)

@@ -31,6 +31,10 @@ class BodyModel:
         Unworn vertices, body frame (m).
     tributary_area : (n,) float
         Barycentric vertex areas of the reference mesh (m²).
+    area_vectors : (n, 4) float
+        Area vectors of the reference mesh and their lengths (m², body frame,
+        :func:`meshwear.geometry.area_vectors`): projected on a plane they
+        give each vertex's contact area there.
     wear_direction : (n, 3) or (0, 3) float
         Inward vertex normals when wear moves along them, else empty.
     reference_face_normals : (m, 3) float
@@ -50,6 +54,7 @@ class BodyModel:
     faces: np.ndarray
     reference_vertices: np.ndarray
     tributary_area: np.ndarray
+    area_vectors: np.ndarray
     wear_direction: np.ndarray
     reference_face_normals: np.ndarray
     mass: float
@@ -102,8 +107,8 @@ class BodyState:
         Centre of mass, quaternion, velocity, angular velocity (world).
     vertices : (n, 3) float
         Worn vertices in the body frame (m).
-    wear_depth, friction_work : (n,) float
-        ``w`` (m) and ``E`` (J) per vertex.
+    wear_depth, friction_work, wear_volume : (n,) float
+        ``w`` (m), ``E`` (J) and worn volume (m³) per vertex.
     contact_state : (P, n) int8
     tangential : (P, n, 4, 3) float
         Stick anchor, stick-start force, friction force, last slip velocity.
@@ -116,6 +121,7 @@ class BodyState:
     vertices: np.ndarray
     wear_depth: np.ndarray
     friction_work: np.ndarray
+    wear_volume: np.ndarray
     contact_state: np.ndarray
     tangential: np.ndarray
     normal_force: np.ndarray
@@ -260,6 +266,7 @@ def _build_body(scene, index, body):
         raise SceneError(scene.source, key, "initial pose is not finite")
     return BodyModel(
         name=body.name, faces=faces, reference_vertices=body_vertices, tributary_area=area,
+        area_vectors=geometry.area_vectors(body_vertices, faces),
         wear_direction=wear_direction,
         reference_face_normals=geometry.face_normals(body_vertices, faces),
         mass=float(mass), inertia=inertia, origin=-com, initial_pose=pose, motion=motion,
@@ -286,8 +293,10 @@ def _refuse_deep_start(scene, index, body, config, planes):
 
 
 def point_coefficients(model, body):
-    """Per-vertex ``c, d, c_t, d_t`` (n,) of ``body`` (N/m, N·s/m)."""
-    a = body.tributary_area
+    """Largest per-vertex ``c, d, c_t, d_t`` (n,) of ``body`` over all plane
+    orientations (N/m, N·s/m): per-area coefficients at the full length of
+    the area vector."""
+    a = body.area_vectors[:, 3]
     return tuple(model.law[5 + 2 * j] + model.law[6 + 2 * j] * a for j in range(4))  # LAW_SLOTS
 
 
@@ -299,7 +308,7 @@ def initial_state(model):
         n = len(b.tributary_area)
         bodies.append(BodyState(
             pose=b.initial_pose.copy(), vertices=b.reference_vertices.copy(),
-            wear_depth=np.zeros(n), friction_work=np.zeros(n),
+            wear_depth=np.zeros(n), friction_work=np.zeros(n), wear_volume=np.zeros(n),
             contact_state=np.zeros((P, n), dtype=np.int8),
             tangential=np.zeros((P, n, 4, 3)), normal_force=np.zeros((P, n))))
     return State(time=0.0, step=0, bodies=bodies)

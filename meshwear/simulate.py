@@ -24,9 +24,9 @@ class NumericalError(RuntimeError):
 def step(model, state):
     """Advance ``state`` by one time step of ``model``, in place."""
     for body, s in zip(model.bodies, state.bodies):
-        plane_contact(s.vertices, s.pose, model.planes, body.tributary_area, model.law,
+        plane_contact(s.vertices, s.pose, model.planes, body.area_vectors, model.law,
                       body.wear_direction, s.contact_state, s.tangential, s.normal_force,
-                      s.friction_work, s.wear_depth, s.wrench)
+                      s.friction_work, s.wear_depth, s.wear_volume, s.wrench)
     for body, s in zip(model.bodies, state.bodies):
         body.motion.advance(s.pose, s.wrench, state.time, model.dt)
     state.step += 1

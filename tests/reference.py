@@ -24,16 +24,25 @@ def _dot(a, b):
     return np.einsum("ij,ij->i", a, b)
 
 
+FACING = 1e-3
+
+
 def point_coefficients(area, law):
     """c, d, c_t, d_t (n,) from the (per point, per area) pairs of ``law``."""
     return tuple(law[5 + 2 * j] + law[6 + 2 * j] * area for j in range(4))
 
 
-def plane_contact(body_vertices, pose, planes, area, law, wear_direction,
-                  contact_state, tangential, normal_force, friction_work, wear_depth, wrench):
+def contact_areas(area_vectors, R, n):
+    """(n,) contact area of each vertex against the plane of normal ``n``:
+    its world area vector projected on -n."""
+    return -(area_vectors[:, 0:3] @ R.T) @ n
+
+
+def plane_contact(body_vertices, pose, planes, area_vectors, law, wear_direction,
+                  contact_state, tangential, normal_force, friction_work, wear_depth,
+                  wear_volume, wrench):
     """Same contract as :func:`meshwear.kernels.contact.plane_contact`."""
     f, f0, wear_law, k, dt = law[0], law[1], int(law[2]), law[3], law[4]
-    c, d, ct, dtan = point_coefficients(area, law)
     R = quaternion_matrix(pose[3:7])
     r = body_vertices @ R.T
     x = pose[0:3] + r
@@ -43,7 +52,10 @@ def plane_contact(body_vertices, pose, planes, area, law, wear_direction,
     for s in range(planes.shape[0]):
         p, n, vel = planes[s]
         delta = (x - p) @ n
-        touching = delta < 0.0
+        area = contact_areas(area_vectors, R, n)
+        touching = (delta < 0.0) & (area > FACING * area_vectors[:, 3])
+        c, d, ct, dtan = point_coefficients(area, law)
+        safe_area = np.where(touching, area, 1.0)
         g = u - vel
         rate = g @ n
         slip_v = g - np.outer(rate, n)
@@ -84,10 +96,13 @@ def plane_contact(body_vertices, pose, planes, area, law, wear_direction,
         energy = np.where(stick, dtan * speed ** 2 * dt, np.where(slip, f * load * speed * dt, 0.0))
         if wear_law == ENERGY:
             dw = k * energy
+            dv = dw * area
         elif wear_law == ENERGY_DENSITY:
-            dw = k * energy / area
+            dv = k * energy
+            dw = dv / safe_area
         else:
-            dw = np.where(slip, k * load / area * speed * dt, 0.0)
+            dv = np.where(slip, k * load * speed * dt, 0.0)
+            dw = dv / safe_area
 
         direction = wear_direction if wear_direction.shape[0] else np.tile(R.T @ n, (len(dw), 1))
         if wear_direction.shape[0]:
@@ -102,6 +117,7 @@ def plane_contact(body_vertices, pose, planes, area, law, wear_direction,
         T[:, 2] = F
         friction_work += energy
         wear_depth += dw
+        wear_volume += np.where(dw > 0.0, dv, 0.0)
         moves += dw[:, None] * direction
         force += np.where(touching[:, None], load[:, None] * n + F, 0.0)
     body_vertices += moves

@@ -500,9 +500,9 @@ def test_good_run_summary(good_run):
         assert len(body["orientation"]) == 4
         assert np.linalg.norm(body["orientation"]) == pytest.approx(1.0, rel=1e-9)
         last = [r for r in rows if r["body"] == name][-1]
-        assert body["wear_volume"] == pytest.approx(float(last["wear_volume"]), rel=1e-12)
-        assert body["max_wear_depth"] == pytest.approx(float(last["max_wear_depth"]), rel=1e-12)
-        assert body["friction_work"] == pytest.approx(float(last["friction_work"]), rel=1e-12)
+        assert body["wear_volume"] == pytest.approx(float(last["wear_volume"]), rel=1e-12, abs=0.0)
+        assert body["max_wear_depth"] == pytest.approx(float(last["max_wear_depth"]), rel=1e-12, abs=0.0)
+        assert body["friction_work"] == pytest.approx(float(last["friction_work"]), rel=1e-12, abs=0.0)
         np.testing.assert_allclose(body["position"], [float(last[c]) for c in "xyz"], rtol=1e-12)
         assert body["wear_volume"] > 0.0
 
@@ -623,7 +623,7 @@ def test_info_describes_a_generated_stl(tmp_path, capsys, caplog):
     # the same file read as millimetres
     code, out, _ = cli(capsys, caplog, "info", mesh, "--units", "mm")
     info = dict(line.split(": ", 1) for line in out.splitlines())
-    assert code == 0 and float(info["volume"]) == pytest.approx(a * b * c * 1e-9, rel=1e-6)
+    assert code == 0 and float(info["volume"]) == pytest.approx(a * b * c * 1e-9, rel=1e-6, abs=0.0)
 
 
 def test_demo_runs_and_prints_its_series(tmp_path, capsys, caplog):

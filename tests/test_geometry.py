@@ -329,3 +329,22 @@ def test_fe_formats_load_through_meshio(tmp_path, ext):
     v, f = geometry.load_mesh(path, units="mm")
     assert f.shape == (12, 3)
     np.testing.assert_allclose(np.ptp(v, axis=0), [0.01, 0.02, 0.03], rtol=1e-12)
+
+
+def test_area_vectors_project_to_the_footprint():
+    # a flat-ended cylinder: on a plane under its end face, the end-face
+    # vertices (rim included) add up to the end polygon's area; the side
+    # wall, standing on the plane, contributes nothing
+    vertices, faces = geometry.primitive("cylinder", radius=0.003, height=0.01, sections=48)
+    a = geometry.area_vectors(vertices, faces)
+    assert np.allclose(a.sum(axis=0)[0:3], 0.0, atol=1e-18)  # a closed surface
+    bottom = vertices[:, 2] < vertices[:, 2].min() + 1e-12
+    polygon = 0.5 * 48 * 0.003 ** 2 * np.sin(2 * np.pi / 48)
+    assert (-a[bottom, 2]).sum() == pytest.approx(polygon, rel=1e-12, abs=0.0)
+    # the unprojected tributary areas of the rim carry a share of the wall
+    assert geometry.tributary_areas(vertices, faces)[bottom].sum() > 2 * polygon
+    # every length is at most the tributary area, equal on a flat face
+    tributary = geometry.tributary_areas(vertices, faces)
+    assert np.all(a[:, 3] <= tributary * (1 + 1e-12))
+    centre = bottom & (np.linalg.norm(vertices[:, 0:2], axis=1) < 1e-12)
+    assert a[centre, 3] == pytest.approx(tributary[centre], rel=1e-12)

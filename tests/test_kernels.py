@@ -7,6 +7,7 @@ import reference
 from meshwear.kernels import contact, rigid
 
 RTOL = 1e-12
+FACING_DOWN = np.array([[0.0, 0.0, -1e-6, 1e-6]])  # area vector of 1 mm², facing -z
 
 
 def _random_case(rng, n, n_planes, wear_law, along_vertex_normal):
@@ -23,7 +24,11 @@ def _random_case(rng, n, n_planes, wear_law, along_vertex_normal):
         planes[s, 1] = normal / np.linalg.norm(normal)
         planes[s, 0] = rng.normal(scale=0.002, size=3)
         planes[s, 2] = rng.normal(scale=0.01, size=3)
-    params = rng.uniform(1e-6, 4e-6, n)
+    # area vectors: mostly facing the planes (-z), some sideways or away
+    directions = rng.normal(size=(n, 3)) + [0.0, 0.0, -1.5]
+    params = np.zeros((n, 4))
+    params[:, 0:3] = rng.uniform(1e-6, 4e-6, (n, 1)) * directions / np.linalg.norm(directions, axis=1)[:, None]
+    params[:, 3] = np.linalg.norm(params[:, 0:3], axis=1)
     # per-point normal law, Winkler (per-area) tangential law: both paths covered
     law = contact.make_law(friction=0.3, static_friction=0.4, wear_law=wear_law,
                            wear_coefficient=1e-7, dt=1e-5, stiffness=5e4, damping=2.0,
@@ -37,13 +42,14 @@ def _random_case(rng, n, n_planes, wear_law, along_vertex_normal):
         contact_state=np.zeros((n_planes, n), np.int8),
         tangential=np.zeros((n_planes, n, 4, 3)),
         normal_force=np.zeros((n_planes, n)),
-        friction_work=np.zeros(n), wear_depth=np.zeros(n), wrench=np.zeros(6))
+        friction_work=np.zeros(n), wear_depth=np.zeros(n), wear_volume=np.zeros(n),
+        wrench=np.zeros(6))
     return vertices, pose, planes, params, law, direction, arrays
 
 
 def _call(fn, vertices, pose, planes, params, law, direction, a):
     fn(vertices, pose, planes, params, law, direction, a["contact_state"], a["tangential"],
-       a["normal_force"], a["friction_work"], a["wear_depth"], a["wrench"])
+       a["normal_force"], a["friction_work"], a["wear_depth"], a["wear_volume"], a["wrench"])
 
 
 def _close(a, b):
@@ -91,12 +97,12 @@ def test_contact_state_machine_transitions():
     planes = np.zeros((1, 3, 3))
     planes[0, 1, 2] = 1.0
     c = 1e6
-    params = np.array([1e-6])
+    params = FACING_DOWN
     law = contact.make_law(friction=0.5, static_friction=0.5, wear_law="energy",
                            wear_coefficient=0.0, dt=1e-3, stiffness=c, tangential_stiffness=c)
     a = dict(contact_state=np.zeros((1, 1), np.int8), tangential=np.zeros((1, 1, 4, 3)),
              normal_force=np.zeros((1, 1)), friction_work=np.zeros(1), wear_depth=np.zeros(1),
-             wrench=np.zeros(6))
+             wear_volume=np.zeros(1), wrench=np.zeros(6))
     N = c * 1e-6
     _call(contact.plane_contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
     assert a["contact_state"][0, 0] == contact.STICK
@@ -200,8 +206,8 @@ def test_reversal_exactly_on_a_step_starts_stick_despite_a_dip_in_load():
                            wear_coefficient=0.0, dt=1e-5, stiffness=c, tangential_stiffness=c)
     a = dict(contact_state=np.zeros((1, 1), np.int8), tangential=np.zeros((1, 1, 4, 3)),
              normal_force=np.zeros((1, 1)), friction_work=np.zeros(1), wear_depth=np.zeros(1),
-             wrench=np.zeros(6))
-    args = (vertices, pose, planes, np.array([1e-6]), law, np.zeros((0, 3)))
+             wear_volume=np.zeros(1), wrench=np.zeros(6))
+    args = (vertices, pose, planes, FACING_DOWN, law, np.zeros((0, 3)))
     # slide along +x until slipping
     for k in range(10):
         pose[0] = 1e-6 * k
@@ -217,16 +223,16 @@ def test_reversal_exactly_on_a_step_starts_stick_despite_a_dip_in_load():
     # and the twin agrees on the same step
     a2 = dict(contact_state=np.zeros((1, 1), np.int8), tangential=np.zeros((1, 1, 4, 3)),
               normal_force=np.zeros((1, 1)), friction_work=np.zeros(1), wear_depth=np.zeros(1),
-              wrench=np.zeros(6))
+              wear_volume=np.zeros(1), wrench=np.zeros(6))
     pose[2] = -1e-6
     for k in range(10):
         pose[0] = 1e-6 * k
         pose[7] = 1e-3
-        _call(reference.plane_contact, vertices.copy(), pose, planes, np.array([1e-6]), law,
+        _call(reference.plane_contact, vertices.copy(), pose, planes, FACING_DOWN, law,
               np.zeros((0, 3)), a2)
     pose[2] = -1e-6 * (1 - 1e-12)
     pose[7] = -1e-20
-    _call(reference.plane_contact, vertices.copy(), pose, planes, np.array([1e-6]), law,
+    _call(reference.plane_contact, vertices.copy(), pose, planes, FACING_DOWN, law,
           np.zeros((0, 3)), a2)
     assert a2["contact_state"][0, 0] == contact.STICK
     assert _close(a2["tangential"], twin["tangential"])

@@ -15,14 +15,18 @@ pose : (13,)
 planes : (P, 3, 3)
     Per plane: a point on it (m), its unit normal ``n`` pointing into the worn
     body, and its translational velocity (m/s).
-area : (n,)
-    Tributary area ``A_i`` of each vertex (m²).
+area : (n, 4)
+    Area vector of each vertex in the body frame (m², the third of each
+    adjacent face's area times its outward unit normal, summed) and its
+    length. Against a plane of normal ``n`` the vertex's contact area is
+    ``A_i = -(R a_i) . n``, its tributary area projected on the plane; a
+    vertex with ``A_i`` below :data:`FACING` of its length does not touch.
 law : (13,)
     ``f``, ``f0``, wear law code (:data:`ENERGY`, :data:`ENERGY_DENSITY`,
     :data:`ARCHARD`), wear coefficient ``k``, time step ``dt`` (s), then the
     contact coefficients as (per point, per area) pairs: normal stiffness,
     normal damping, tangential stiffness, tangential damping. Point ``i`` gets
-    ``c_i = c_point + c_area A_i`` (N/m), and likewise ``d_i``, ``c_t,i``,
+    ``c_i = c_point + c_area A_i`` (N/m), ``A_i`` the contact area, and likewise ``d_i``, ``c_t,i``,
     ``d_t,i``: one of each pair is zero (DESIGN.md §1, per point or Winkler).
 body_vertices : (n, 3)
     Worn vertex positions in the body frame (m, relative to the centre of
@@ -38,8 +42,9 @@ tangential : (P, n, 4, 3)
     last non-zero slip velocity (m/s); updated in place.
 normal_force : (P, n)
     ``N`` (N), written.
-friction_work, wear_depth : (n,)
-    Cumulative dissipated energy ``E`` (J) and wear depth ``w`` (m); increased.
+friction_work, wear_depth, wear_volume : (n,)
+    Cumulative dissipated energy ``E`` (J), wear depth ``w`` (m) and worn
+    volume (m³, the depth increments times the contact area); increased.
 wrench : (6,)
     Total contact force (N, world) and torque about the centre of mass (N·m),
     written.
@@ -75,6 +80,10 @@ def make_law(*, friction, static_friction, wear_law, wear_coefficient, dt,
     values = dict(locals())
     return np.array([float(values[name]) for name in LAW_SLOTS])
 
+#: a vertex touches a plane only where its area vector, projected on the
+#: plane, exceeds this fraction of its length (its surface faces the plane)
+FACING = 1e-3
+
 # Pairs with at least this many vertex-plane pairs use the threaded kernel;
 # below it thread start-up costs more than the work.
 PARALLEL_THRESHOLD = 4096
@@ -91,7 +100,7 @@ def rotation_entries(q):
 
 def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                    contact_state, tangential, normal_force,
-                   friction_work, wear_depth, wrench):
+                   friction_work, wear_depth, wear_volume, wrench):
     n_points = body_vertices.shape[0]
     n_planes = planes.shape[0]
     f, f0, wear_law, k, dt = law[0], law[1], int(law[2]), law[3], law[4]
@@ -103,9 +112,14 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
     vx, vy, vz = pose[7], pose[8], pose[9]
     wx, wy, wz = pose[10], pose[11], pose[12]
     fx = fy = fz = tx = ty = tz = 0.0
+    # plane normals in the body frame, R^T n
+    local = np.empty((n_planes, 3))
+    for s in range(n_planes):
+        nx, ny, nz = planes[s, 1, 0], planes[s, 1, 1], planes[s, 1, 2]
+        local[s, 0] = r00 * nx + r10 * ny + r20 * nz
+        local[s, 1] = r01 * nx + r11 * ny + r21 * nz
+        local[s, 2] = r02 * nx + r12 * ny + r22 * nz
     for i in prange(n_points):
-        a = area[i]
-        c, d, ct, dtan = c0 + c1 * a, d0 + d1 * a, ct0 + ct1 * a, dt0 + dt1 * a
         bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
         # world offset from the centre of mass, position and velocity of point A
         rx = r00 * bx + r01 * by + r02 * bz
@@ -120,7 +134,11 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
             # Delta = (x - p) . n, negative in penetration
             delta = ((px - planes[s, 0, 0]) * nx + (py - planes[s, 0, 1]) * ny
                      + (pz - planes[s, 0, 2]) * nz)
-            if delta >= 0.0:
+            # contact area: the vertex's area vector projected on the plane,
+            # -(R a) . n; a vertex whose surface does not face the plane
+            # (a side face standing on it) carries nothing
+            a = -(local[s, 0] * area[i, 0] + local[s, 1] * area[i, 1] + local[s, 2] * area[i, 2])
+            if delta >= 0.0 or a <= FACING * area[i, 3]:
                 contact_state[s, i] = NO_CONTACT
                 normal_force[s, i] = 0.0
                 for j in range(3):
@@ -130,6 +148,7 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
             gx, gy, gz = ux - planes[s, 2, 0], uy - planes[s, 2, 1], uz - planes[s, 2, 2]
             rate = gx * nx + gy * ny + gz * nz
             sx, sy, sz = gx - rate * nx, gy - rate * ny, gz - rate * nz
+            c, d, ct, dtan = c0 + c1 * a, d0 + d1 * a, ct0 + ct1 * a, dt0 + dt1 * a
             # eq. 1: spring-damper normal force, no adhesion
             load = -(c * delta + d * rate)
             if load < 0.0:
@@ -221,18 +240,22 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                 energy = f * load * speed * dt
             contact_state[s, i] = state
             tangential[s, i, FORCE, 0], tangential[s, i, FORCE, 1], tangential[s, i, FORCE, 2] = Fx, Fy, Fz
-            # eq. 5 and variants: wear depth increment
+            # eq. 5 and variants: wear depth and volume increments
             if wear_law == ENERGY:
                 dw = k * energy
+                dv = dw * a
             elif wear_law == ENERGY_DENSITY:
-                dw = k * energy / a
+                dv = k * energy
+                dw = dv / a
             elif state == SLIP:
-                dw = k * load / a * speed * dt
+                dv = k * load * speed * dt
+                dw = dv / a
             else:
-                dw = 0.0
+                dw = dv = 0.0
             friction_work[i] += energy
-            wear_depth[i] += dw
             if dw > 0.0:
+                wear_depth[i] += dw
+                wear_volume[i] += dv
                 # geometry update: into the body along +n, in the body frame
                 if along_vertex_normal:
                     mx, my, mz = wear_direction[i, 0], wear_direction[i, 1], wear_direction[i, 2]
@@ -248,9 +271,7 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                         tangential[s, i, ANCHOR, 1] += dw * (hy - hn * ny)
                         tangential[s, i, ANCHOR, 2] += dw * (hz - hn * nz)
                 else:
-                    mx = r00 * nx + r10 * ny + r20 * nz
-                    my = r01 * nx + r11 * ny + r21 * nz
-                    mz = r02 * nx + r12 * ny + r22 * nz
+                    mx, my, mz = local[s, 0], local[s, 1], local[s, 2]
                 body_vertices[i, 0] += dw * mx
                 body_vertices[i, 1] += dw * my
                 body_vertices[i, 2] += dw * mz
@@ -288,7 +309,7 @@ plane_contact_parallel = njit(cache=True, parallel=True, fastmath=_FLAGS)(
 
 def plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                   contact_state, tangential, normal_force,
-                  friction_work, wear_depth, wrench):
+                  friction_work, wear_depth, wear_volume, wrench):
     """Contact, friction and wear of every vertex against every plane, one step.
 
     See the module docstring for the arrays. Picks the threaded kernel when the
@@ -298,4 +319,4 @@ def plane_contact(body_vertices, pose, planes, area, law, wear_direction,
               if body_vertices.shape[0] * planes.shape[0] >= PARALLEL_THRESHOLD
               else plane_contact_serial)
     kernel(body_vertices, pose, planes, area, law, wear_direction,
-           contact_state, tangential, normal_force, friction_work, wear_depth, wrench)
+           contact_state, tangential, normal_force, friction_work, wear_depth, wear_volume, wrench)

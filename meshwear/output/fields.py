@@ -5,8 +5,11 @@ import numpy as np
 from ..kernels.contact import FORCE, rotation_entries
 
 
-def body_quantities(body, s):
+def body_quantities(body, s, planes):
     """Per-vertex fields and totals of one body, for recorders.
+
+    ``planes`` is the model's (P, 3, 3) plane array: the pressure of a vertex
+    is its normal force over its contact area on each plane, summed.
 
     Returns
     -------
@@ -17,17 +20,22 @@ def body_quantities(body, s):
     R = np.array(rotation_entries(s.pose[3:7])).reshape(3, 3)
     normal_force = s.normal_force.sum(axis=0)
     friction_force = s.tangential[:, :, FORCE, :].sum(axis=0)
+    pressure = np.zeros(len(s.wear_depth))
+    for j in range(planes.shape[0]):
+        area = -(body.area_vectors[:, 0:3] @ R.T) @ planes[j, 1]
+        loaded = s.normal_force[j] > 0.0
+        pressure[loaded] += s.normal_force[j][loaded] / area[loaded]
     return {
         "points": s.pose[0:3] + s.vertices @ R.T,
         "origin": s.pose[0:3] + R @ body.origin,
         "wear_depth": s.wear_depth,
         "normal_force": normal_force,
         "friction_force": friction_force,
-        "pressure": normal_force / body.tributary_area,
+        "pressure": pressure,
         "contact_state": (s.contact_state.max(axis=0) if s.contact_state.shape[0]
                           else np.zeros(len(s.wear_depth), np.int8)).astype(np.int32),
         "friction_work": s.friction_work,
-        "wear_volume": float(s.wear_depth @ body.tributary_area),
+        "wear_volume": float(s.wear_volume.sum()),
         "max_wear_depth": float(s.wear_depth.max()),
         "total_friction_work": float(s.friction_work.sum()),
     }
