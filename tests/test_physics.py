@@ -463,7 +463,6 @@ def test_jenkins_loop_with_turning_points_on_steps_and_many_points(measured):
         scene.run, dt=4e-6, duration=0.25, history=26, frames=0))
     model, state, history = run_scene(scene)
     body = model.bodies[0]
-    bottom = body.reference_vertices[:, 2] < body.reference_vertices[:, 2].min() + 1e-9
     load = body.mass * G + 50.0
     k_t = 1e12 * 0.01 * 0.01  # Winkler: K times the 10 x 10 mm footprint
     mu, amplitude = 0.3, 2e-6
