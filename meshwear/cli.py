@@ -134,7 +134,10 @@ def _check(scene_path):
               f"mass {mass}, motion {config.motion}")
     for p in model.plane_list:
         print(f"  plane {p.name!r}: point {p.point.tolist()}, normal {p.normal.tolist()}")
-    print(f"  dt {model.dt:.3g} s, largest stable dt {limit:.3g} s, {model.n_steps} steps, "
+    stable = (f"largest stable dt {limit:.3g} s" if np.isfinite(limit)
+              else "no stability limit (quasi-static)" if model.quasi_static
+              else "no stability limit (nothing integrated in time)")
+    print(f"  dt {model.dt:.3g} s, {stable}, {model.n_steps} steps, "
           f"{len(model.frame_steps)} frames, {len(model.sample_steps)} history rows")
     state = initial_state(model)
     step(model, state)  # compile (or load the cached) kernels

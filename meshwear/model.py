@@ -5,13 +5,14 @@ arrays once; :func:`initial_state` allocates every array a run writes into, so
 a step allocates nothing. Kernels see only these arrays.
 """
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import geometry
-from .kernels.contact import make_law, rotation_entries
-from .motion import FixedMotion, FreeMotion, GuidedMotion, Path, PrescribedMotion
+from .kernels.contact import make_law, plane_contact, rotation_entries
+from .motion import BalancedMotion, FixedMotion, FreeMotion, GuidedMotion, Path, PrescribedMotion
 from .scene import SceneError
 
 #: fraction of the estimated stability limit accepted as the largest stable dt
@@ -86,6 +87,7 @@ class Model:
     plane_list: tuple
     planes: np.ndarray
     law: np.ndarray
+    quasi_static: bool
     dt: float
     n_steps: int
     sample_steps: np.ndarray
@@ -145,9 +147,6 @@ def build_model(scene):
     """
     # parts of format 1 that this version reads but cannot carry out yet are
     # refused here, so no run silently does something other than asked
-    if scene.run.mode != "dynamic":
-        raise SceneError(scene.source, "run.mode", f"{scene.run.mode!r} is not supported by this "
-                         "version; use 'dynamic'")
     if scene.wear.acceleration != "none":
         raise SceneError(scene.source, "wear.acceleration", f"{scene.wear.acceleration!r} is not "
                          "supported by this version; use 'none' (every cycle resolved)")
@@ -181,6 +180,11 @@ def build_model(scene):
     bodies = tuple(bodies)
     c = scene.contact
     (ct, ct_area), (dt_point, dt_area) = c.tangential
+    quasi_static = run.mode == "quasi-static"
+    if quasi_static:  # no inertia, so no damping either
+        c = dataclasses.replace(c, damping=0.0, damping_per_area=None, tangential_damping=0.0,
+                                tangential_damping_per_area=None)
+        dt_point, dt_area = 0.0, None
     law = make_law(friction=c.friction, static_friction=c.static_friction,
                    wear_law=scene.wear.law, wear_coefficient=scene.wear.coefficient, dt=dt,
                    stiffness=c.stiffness or 0.0, stiffness_per_area=c.stiffness_per_area or 0.0,
@@ -189,7 +193,15 @@ def build_model(scene):
                    tangential_damping=dt_point or 0.0,
                    tangential_damping_per_area=dt_area or 0.0)
     for j, (b, config) in enumerate(zip(bodies, scene.bodies)):
-        _refuse_deep_start(scene, j, b, config, planes)
+        if isinstance(b.motion, BalancedMotion):
+            if not b.motion.settle(b.initial_pose, b.reference_vertices, b.area_vectors,
+                                   plane_array, law):
+                raise SceneError(scene.source, f"body[{j}].path.free_axis",
+                                 f"no surface can carry the load of body {config.name!r} along "
+                                 f"{list(config.path.free_axis)} (the load pulls it off every "
+                                 "plane, or no plane faces it along that axis)")
+        else:
+            _refuse_deep_start(scene, j, b, config, planes)
     periods = [b.period for b in bodies if b.period is not None]
     period = scene.wear.period or (max(periods) if periods else None)
     # a plane without a size is drawn 4 body extents wide
@@ -197,7 +209,7 @@ def build_model(scene):
     planes = tuple(p if p.size is not None else PlaneModel(p.name, p.point, p.normal, 4.0 * extent)
                    for p in planes)
     return Model(scene=scene, bodies=bodies, plane_list=planes, planes=plane_array, law=law,
-                 dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
+                 quasi_static=quasi_static, dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
                  frame_steps=_even_steps(n_steps, run.frames), period=period)
 
 
@@ -255,6 +267,9 @@ def _build_body(scene, index, body):
     path = Path(body.path)
     if body.motion == "free":
         motion = FreeMotion(mass, inertia, acceleration)
+    elif body.motion == "guided" and scene.run.mode == "quasi-static":
+        motion = BalancedMotion(pose[0:3].copy(), path, body.path.free_axis,
+                                mass * acceleration @ np.asarray(body.path.free_axis, float))
     elif body.motion == "guided":
         motion = GuidedMotion(pose[0:3].copy(), path, body.path.free_axis, mass, acceleration)
     elif body.motion == "prescribed":
@@ -311,7 +326,17 @@ def initial_state(model):
             wear_depth=np.zeros(n), friction_work=np.zeros(n), wear_volume=np.zeros(n),
             contact_state=np.zeros((P, n), dtype=np.int8),
             tangential=np.zeros((P, n, 4, 3)), normal_force=np.zeros((P, n))))
-    return State(time=0.0, step=0, bodies=bodies)
+    state = State(time=0.0, step=0, bodies=bodies)
+    if model.quasi_static:
+        # the bodies already sit in balance at t = 0: evaluate their contacts
+        # there (at rest, so nothing slips or wears), for the t = 0 outputs
+        # and the stick anchors the first step starts from
+        for body, s in zip(model.bodies, state.bodies):
+            s.pose[7:13] = 0.0
+            plane_contact(s.vertices, s.pose, model.planes, body.area_vectors, model.law,
+                          body.wear_direction, s.contact_state, s.tangential, s.normal_force,
+                          s.friction_work, s.wear_depth, s.wear_volume, s.wrench)
+    return state
 
 
 def stable_time_step(model):

@@ -12,10 +12,14 @@ Every motion implements
     Advance ``pose`` from ``t`` to ``t + dt`` under the contact ``wrench``.
 ``dynamic_axes``
     The degrees of freedom integrated in time: ``"all"``, ``"axis"`` or ``None``.
+
+In quasi-static runs, :class:`BalancedMotion` (a guided body) also has
+``settle``, which puts the body where its contacts carry its load.
 """
 
 import numpy as np
 
+from .kernels.balance import balance_offset
 from .kernels.rigid import (CIRCLE, OSCILLATION, STEADY, free_step, guided_step,
                             path_point, place_on_path)
 
@@ -131,6 +135,38 @@ class GuidedMotion:
     def advance(self, pose, wrench, t, dt):
         guided_step(pose, wrench, self.inverse_mass, self.acceleration, self.axis, self.start,
                     self.path.terms, t, dt, self.path.buffer)
+
+
+class BalancedMotion:
+    """Quasi-static guided body: every degree of freedom but ``free_axis``
+    follows ``start + path(t)``; along the axis the body sits where the
+    contact normal forces balance the applied ``load`` (N along the axis:
+    gravity and the constant force), found by
+    :func:`meshwear.kernels.balance.balance_offset`. No inertia, no damping.
+    """
+
+    dynamic_axes = None
+
+    def __init__(self, start, path, free_axis, load):
+        self.axis = np.asarray(free_axis, float)
+        self.start = np.asarray(start, float)
+        self.path = path
+        #: contact force the planes must supply along the axis (N)
+        self.carried = -float(load)
+
+    def place(self, pose, t):
+        place_on_path(pose, self.start, self.path.terms, self.axis, pose[0:3] @ self.axis,
+                      0.0, t, self.path.buffer)
+
+    def settle(self, pose, vertices, area_vectors, planes, law):
+        """Move ``pose`` along the axis to the balance; False if no contact
+        can carry the load."""
+        z = balance_offset(vertices, pose, self.axis, planes, area_vectors, law,
+                           self.carried, 0.0)
+        if not np.isfinite(z):
+            return False
+        pose[0:3] += z * self.axis
+        return True
 
 
 class FixedMotion:

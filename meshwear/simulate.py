@@ -23,12 +23,39 @@ class NumericalError(RuntimeError):
 
 def step(model, state):
     """Advance ``state`` by one time step of ``model``, in place."""
+    if model.quasi_static:
+        _quasi_static_step(model, state)
+        return
     for body, s in zip(model.bodies, state.bodies):
         plane_contact(s.vertices, s.pose, model.planes, body.area_vectors, model.law,
                       body.wear_direction, s.contact_state, s.tangential, s.normal_force,
                       s.friction_work, s.wear_depth, s.wear_volume, s.wrench)
     for body, s in zip(model.bodies, state.bodies):
         body.motion.advance(s.pose, s.wrench, state.time, model.dt)
+    state.step += 1
+    state.time = state.step * model.dt
+
+
+def _quasi_static_step(model, state):
+    """Quasi-static: put every body where it is at the end of the step (on its
+    path, guided ones in load balance), with the velocity of that increment,
+    then evaluate contact, friction and wear there. Friction thus follows the
+    tangential displacement increments, and the contact forces of the new
+    state carry its load exactly."""
+    t = (state.step + 1) * model.dt
+    for body, s in zip(model.bodies, state.bodies):
+        before = s.pose[0:3].copy()
+        body.motion.place(s.pose, t)
+        settle = getattr(body.motion, "settle", None)
+        if settle is not None and not settle(s.pose, s.vertices, body.area_vectors,
+                                             model.planes, model.law):
+            raise NumericalError(f"body {body.name!r}: no contact carries its load at "
+                                 f"t = {t:.6g} s")
+        s.pose[7:10] = (s.pose[0:3] - before) / model.dt
+        s.pose[10:13] = 0.0
+        plane_contact(s.vertices, s.pose, model.planes, body.area_vectors, model.law,
+                      body.wear_direction, s.contact_state, s.tangential, s.normal_force,
+                      s.friction_work, s.wear_depth, s.wear_volume, s.wrench)
     state.step += 1
     state.time = state.step * model.dt
 

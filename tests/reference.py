@@ -168,3 +168,47 @@ def guided_step(pose, wrench, inverse_mass, acceleration, axis, start, terms, t,
     pose[0:3] = across @ (start + disp) + along * axis
     pose[7:10] = across @ vel + rate * axis
     pose[10:13] = 0.0
+
+
+def balance_offset(body_vertices, pose, axis, planes, area_vectors, law, load):
+    """Same contract as :func:`meshwear.kernels.balance.balance_offset`, solved
+    by another route: sort every breakpoint of the piecewise-linear contact
+    force g(z), evaluate g there, and interpolate in the piece that holds the
+    load."""
+    R = quaternion_matrix(pose[3:7])
+    x = pose[0:3] + body_vertices @ R.T
+    zs, ws, signs = [], [], []
+    for p, n, _ in planes:
+        beta = axis @ n
+        if beta == 0.0:
+            continue
+        area = contact_areas(area_vectors, R, n)
+        c = law[5] + law[6] * area
+        ok = (area > FACING * area_vectors[:, 3]) & (c > 0.0)
+        zs.append(-((x - p) @ n)[ok] / beta)
+        ws.append(c[ok] * beta ** 2)
+        signs.append(np.full(ok.sum(), np.sign(beta)))
+    z_j, w, sign = np.concatenate(zs), np.concatenate(ws), np.concatenate(signs)
+    carrying = sign > 0 if load >= 0 else sign < 0
+    if not carrying.any():
+        return np.nan
+
+    def g(z):
+        active = np.where(sign > 0, z < z_j, z > z_j)
+        return (w * (z_j - z))[active].sum()
+
+    points = np.unique(z_j)
+    values = np.array([g(z) for z in points])      # non-increasing in z
+    # g is linear between neighbouring breakpoints, and beyond the outermost
+    # ones with the slope of the pairs active there
+    if load >= values[0]:
+        left = points[0]
+        slope = w[(sign > 0)].sum()
+        return left - (load - values[0]) / slope
+    if load <= values[-1]:
+        right = points[-1]
+        slope = w[(sign < 0)].sum()
+        return right + (values[-1] - load) / slope
+    k = np.searchsorted(-values, -load)            # values[k-1] > load >= values[k]
+    z0, z1, g0, g1 = points[k - 1], points[k], values[k - 1], values[k]
+    return z0 + (g0 - load) / (g0 - g1) * (z1 - z0)

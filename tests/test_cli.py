@@ -260,12 +260,12 @@ BAD_SCENES = [
     ("cycle_jump_without_period", BASE.replace('coefficient = 1e-6', 'coefficient = 1e-6\nacceleration = "cycle_jump"'),
      {}, ["wear.period", "missing"]),
     ("no_bodies", BASE.split("[[body]]")[0], {}, ["body", "no bodies"]),
-    ("quasi_static_not_supported_yet",
+    ("quasi_static_load_without_carrier",
      BASE.replace("[run]", '[run]\nmode = "quasi-static"').replace(
          "position = [0.0, 0.0, 0.0025]",
          'position = [0.0, 0.0, 0.0025]\nmotion = "guided"\n'
-         'path = { velocity = [0.1, 0.0, 0.0], free_axis = [0.0, 0.0, 1.0] }'), {},
-     ["run.mode", "'quasi-static' is not supported"]),
+         'path = { velocity = [0.0, 0.1, 0.0], free_axis = [1.0, 0.0, 0.0] }'), {},
+     ["body[0].path.free_axis", "no surface can carry the load of body 'block'"]),
     ("cycle_jump_not_supported_yet",
      BASE.replace('coefficient = 1e-6', 'coefficient = 1e-6\nacceleration = "cycle_jump"\nperiod = 0.1'),
      {}, ["wear.acceleration", "'cycle_jump' is not supported"]),
@@ -698,3 +698,9 @@ def test_write_error_mid_run_is_one_line(tmp_path, capsys, caplog, monkeypatch):
                          "-o", tmp_path / "out", "-q")
     assert code == 2 and len(err) == 1, err
     assert "history.csv: cannot write the outputs (No space left on device)" in err[0]
+
+
+def test_check_of_a_quasi_static_scene_has_no_stability_limit(capsys, caplog):
+    code, out, err = cli(capsys, caplog, "check", Path(__file__).parents[1] / "examples" / "pin_on_disc.toml")
+    assert code == 0, err
+    assert "mode quasi-static" in out and "no stability limit (quasi-static)" in out

@@ -236,3 +236,62 @@ def test_reversal_exactly_on_a_step_starts_stick_despite_a_dip_in_load():
           np.zeros((0, 3)), a2)
     assert a2["contact_state"][0, 0] == contact.STICK
     assert _close(a2["tangential"], twin["tangential"])
+
+
+@pytest.mark.parametrize("load", [3.0, 0.02, -1.5])
+@pytest.mark.parametrize("opposed", [False, True])
+def test_balance_offset_matches_numpy_twin(load, opposed):
+    """Bracketed Newton against the sorted piecewise-linear solve: a random
+    point cloud between planes tilted about the free axis (and, when
+    ``opposed``, one facing the other way: g then is not convex)."""
+    from meshwear.kernels.balance import balance_offset
+
+    rng = np.random.default_rng(11)
+    vertices, pose, planes, params, law, direction, arrays = _random_case(rng, 300, 2, 0, False)
+    if opposed:
+        planes[1, 1] = -planes[1, 1]
+        planes[1, 0, 2] += 0.03
+        params[150:, 0:3] = -params[150:, 0:3]   # the upper half faces up
+    law[6] = 3e10  # per-area normal stiffness on top of the per-point one
+    axis = np.array([0.1, -0.2, 1.0])
+    axis /= np.linalg.norm(axis)
+    expected = reference.balance_offset(vertices, pose, axis, planes, params, law, load)
+    if not opposed and load < 0.0:
+        # every plane faces the body from below: nothing can pull it down
+        assert np.isnan(expected)
+        assert np.isnan(balance_offset(vertices, pose, axis, planes, params, law, load, 0.0))
+        return
+    for guess in (0.0, -0.05, 0.05, expected):
+        z = balance_offset(vertices, pose, axis, planes, params, law, load, guess)
+        assert z == pytest.approx(expected, rel=1e-12, abs=1e-15)
+    # the force at the solution is the load
+    moved = pose.copy()
+    moved[0:3] += z * axis
+    s = {k: v.copy() for k, v in arrays.items()}
+    moved[7:13] = 0.0
+    static = law.copy()
+    static[[7, 8, 11, 12]] = 0.0   # no damping, and planes at rest: only normal forces
+    resting = planes.copy()
+    resting[:, 2] = 0.0
+    _call(reference.plane_contact, vertices.copy(), moved, resting, params, static, direction, s)
+    assert s["wrench"][0:3] @ axis == pytest.approx(load, rel=1e-9)
+
+
+def test_balance_offset_refuses_a_load_nothing_can_carry():
+    from meshwear.kernels.balance import balance_offset
+
+    vertices = np.array([[0.0, 0.0, 0.0]])
+    pose = np.zeros(13)
+    pose[3] = 1.0
+    planes = np.zeros((1, 3, 3))
+    planes[0, 1, 2] = 1.0
+    law = contact.make_law(friction=0.3, static_friction=0.3, wear_law="energy",
+                           wear_coefficient=0.0, dt=1e-5, stiffness=1e6)
+    up = np.array([0.0, 0.0, 1.0])
+    # a plane under the point carries a load pressing down (contact pushes +z) ...
+    assert balance_offset(vertices, pose, up, planes, FACING_DOWN, law, 2.0, 0.0) == pytest.approx(-2e-6)
+    # ... but nothing can pull it down: a load along -z has no carrier
+    assert np.isnan(balance_offset(vertices, pose, up, planes, FACING_DOWN, law, -2.0, 0.0))
+    # and a free axis lying in the plane has no normal-force component at all
+    assert np.isnan(balance_offset(vertices, pose, np.array([1.0, 0.0, 0.0]), planes, FACING_DOWN,
+                                   law, 2.0, 0.0))

@@ -1,0 +1,310 @@
+"""Validation cases: an example scene each, run and compared with its closed
+form (DESIGN.md §1) at the tolerance of §6.
+
+``tests/test_validation.py`` asserts every row; ``benchmarks/validate.py``
+runs the same functions, writes ``docs/validation.md`` and draws the plots
+from the ``data`` each case returns. Closed forms are computed here from the
+scene's own parameters, never from an earlier run.
+"""
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+
+from meshwear.kernels.contact import rotation_entries
+from meshwear.scene import load_scene
+from meshwear.simulate import run_scene
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+VALIDATION = EXAMPLES / "validation"
+
+
+@dataclasses.dataclass
+class Row:
+    """One line of the report."""
+
+    case: str
+    quantity: str
+    closed_form: float
+    measured: float
+    tolerance: float
+    unit: str = ""
+    relative: bool = True
+
+    @property
+    def error(self):
+        if self.relative:
+            return abs(self.measured - self.closed_form) / abs(self.closed_form)
+        return abs(self.measured - self.closed_form)
+
+    @property
+    def ok(self):
+        return bool(self.error <= self.tolerance)
+
+
+@dataclasses.dataclass
+class Case:
+    name: str
+    scene: Path
+    rows: list
+    data: dict = dataclasses.field(default_factory=dict)
+
+
+class Samples:
+    """Observer keeping what the validation plots need at every history sample."""
+
+    def __init__(self):
+        self.time, self.pose, self.wrench, self.normal_force, self.wear_depth = [], [], [], [], []
+        self.friction_work, self.wear_volume, self.vertices = [], [], []
+
+    def on_frame(self, model, state):
+        pass
+
+    def on_sample(self, model, state):
+        s = state.bodies[0]
+        self.time.append(state.time)
+        self.pose.append(s.pose.copy())
+        self.wrench.append(s.wrench.copy())
+        self.normal_force.append(s.normal_force.sum(axis=0))
+        self.wear_depth.append(s.wear_depth.copy())
+        self.friction_work.append(s.friction_work.sum())
+        self.wear_volume.append(s.wear_volume.sum())
+
+    def arrays(self):
+        return {k: np.asarray(v) for k, v in vars(self).items() if v}
+
+
+def _run(scene, **run_changes):
+    if run_changes:
+        scene = dataclasses.replace(scene, run=dataclasses.replace(scene.run, **run_changes))
+    samples = Samples()
+    model, state, _ = run_scene(scene, observers=[samples])
+    return model, state, samples.arrays()
+
+
+def _load(model, scene):
+    """The load (N) the planes carry: gravity on the body plus its force, along
+    the free axis."""
+    body, axis = scene.bodies[0], np.asarray(scene.bodies[0].path.free_axis)
+    weight = model.bodies[0].mass * np.asarray(scene.run.gravity)
+    return -float((weight + np.asarray(body.force)) @ axis)
+
+
+def _contact_area(body, pose):
+    """Contact areas (n,) of the body on the +z plane at ``pose``."""
+    R = np.array(rotation_entries(pose[3:7])).reshape(3, 3)
+    return np.maximum(-(body.area_vectors[:, 0:3] @ R.T)[:, 2], 0.0)
+
+
+def _lowest(model, state):
+    """Depth (m) of the deepest vertex below the z = 0 plane."""
+    s = state.bodies[0]
+    R = np.array(rotation_entries(s.pose[3:7])).reshape(3, 3)
+    return -float((s.pose[0:3] + s.vertices @ R.T)[:, 2].min())
+
+
+# ---------------------------------------------------------------- the cases
+
+def winkler_sphere(loads=(1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0)):
+    """Approach of a ball on a Winkler foundation: delta = sqrt(P / (pi K R))."""
+    scene = load_scene(VALIDATION / "winkler_sphere.toml")
+    K = scene.contact.stiffness_per_area
+    R = scene.bodies[0].shape.radius
+    model, state, _ = _run(scene)
+    P = _load(model, scene)
+    delta = _lowest(model, state)
+    rows = [Row("Winkler sphere", f"approach at P = {P:g} N", np.sqrt(P / (np.pi * K * R)),
+                delta, 1e-2, "m")]
+    curve = []
+    for load in loads:
+        body = dataclasses.replace(scene.bodies[0], force=(0.0, 0.0, -load))
+        m, s, _ = _run(dataclasses.replace(scene, bodies=(body,)))
+        curve.append((load, _lowest(m, s)))
+    curve = np.array(curve)
+    data = {"load": curve[:, 0], "approach": curve[:, 1],
+            "closed": np.sqrt(curve[:, 0] / (np.pi * K * R)),
+            "touching": int((state.bodies[0].contact_state > 0).sum())}
+    return Case("winkler_sphere", VALIDATION / "winkler_sphere.toml", rows, data)
+
+
+def flat_pin():
+    """Uniform wear of a flat-ended pin: w = k p s, p = P / A."""
+    scene = load_scene(VALIDATION / "flat_pin.toml")
+    model, state, samples = _run(scene)
+    body, s = model.bodies[0], state.bodies[0]
+    end = body.reference_vertices[:, 2] < body.reference_vertices[:, 2].min() + 1e-12
+    sections = scene.bodies[0].shape.sections
+    r = scene.bodies[0].shape.radius
+    face = 0.5 * sections * r * r * np.sin(2 * np.pi / sections)   # the end polygon
+    distance = np.linalg.norm(scene.bodies[0].path.velocity) * model.duration
+    k, P = scene.wear.coefficient, _load(model, scene)
+    depth = s.wear_depth[end]
+    rows = [Row("flat-ended pin, archard", "mean wear depth", k * P / face * distance,
+                float(depth.mean()), 5e-3, "m"),
+            Row("flat-ended pin, archard", "max / min wear depth", 1.0,
+                float(depth.max() / depth.min()), 1e-2, "")]
+    return Case("flat_pin", VALIDATION / "flat_pin.toml", rows, {"depth": depth})
+
+
+def cap_depth(volume, R):
+    """Depth h of a spherical cap of ``volume``: pi h^2 (R - h/3) = V (Newton)."""
+    h = np.sqrt(volume / (np.pi * R))
+    for _ in range(50):
+        h -= (np.pi * h * h * (R - h / 3) - volume) / (np.pi * (2 * R * h - h * h))
+    return h
+
+
+def sphere_pin(scene_path=VALIDATION / "sphere_pin.toml", **changes):
+    """A ball pin slid 10 m: V = k P s and a flat cap of depth h(V)."""
+    scene = load_scene(scene_path)
+    if changes:
+        scene = _with(scene, **changes)
+    model, state, samples = _run(scene)
+    body, s = model.bodies[0], state.bodies[0]
+    R = body.reference_vertices[:, 2].max() - body.reference_vertices[:, 2].min()
+    R = 0.5 * R
+    distance = np.linalg.norm(scene.bodies[0].path.velocity) * model.duration
+    k, P = scene.wear.coefficient, _load(model, scene)
+    volume = float(s.wear_volume.sum())
+    h = cap_depth(k * P * distance, R)
+    rows = [Row("ball pin slid 10 m, archard", "worn volume", k * P * distance, volume, 1e-2, "m³"),
+            Row("ball pin slid 10 m, archard", "max wear depth", h, float(s.wear_depth.max()),
+                2e-2, "m")]
+    # the worn profile: depth against the distance from the pin's axis
+    radius = np.linalg.norm(body.reference_vertices @ _axes(s.pose), axis=1)
+    lower = _lowest_half(body, s.pose)
+    data = {"radius": radius[lower], "depth": s.wear_depth[lower], "h": h, "R": R,
+            "vertices": len(body.reference_vertices)}
+    return Case("sphere_pin", scene_path, rows, data)
+
+
+def _axes(pose):
+    """Body-frame coordinates -> world x, y (2 columns of R^T)."""
+    R = np.array(rotation_entries(pose[3:7])).reshape(3, 3)
+    return R[0:2].T
+
+
+def _lowest_half(body, pose):
+    R = np.array(rotation_entries(pose[3:7])).reshape(3, 3)
+    return (body.reference_vertices @ R.T)[:, 2] < 0.0
+
+
+def _with(scene, *, subdivisions=None, stiffness=None, law=None, coefficient=None, duration=None):
+    """The scene with the ball refined or coarsened, or another contact or wear law."""
+    body = scene.bodies[0]
+    if subdivisions is not None:
+        body = dataclasses.replace(body, shape=dataclasses.replace(body.shape,
+                                                                   subdivisions=subdivisions))
+    contact, wear, run = scene.contact, scene.wear, scene.run
+    if stiffness is not None:  # per point, N/m
+        contact = dataclasses.replace(contact, stiffness=stiffness, stiffness_per_area=None)
+    if law is not None:
+        wear = dataclasses.replace(wear, law=law, coefficient=coefficient)
+    if duration is not None:
+        run = dataclasses.replace(run, duration=duration)
+    return dataclasses.replace(scene, bodies=(body,), contact=contact, wear=wear, run=run)
+
+
+def tilted_punch():
+    """Pressure differences under a sliding punch decay like exp(-k K s)."""
+    scene = load_scene(VALIDATION / "tilted_punch.toml")
+    model, state, samples = _run(scene)
+    body = model.bodies[0]
+    face = body.reference_vertices[:, 2] < body.reference_vertices[:, 2].min() + 1e-12
+    area = _contact_area(body, samples["pose"][0])[face]
+    pressure = samples["normal_force"][:, face] / area
+    spread = pressure.max(axis=1) - pressure.min(axis=1)
+    speed = np.linalg.norm(scene.bodies[0].path.velocity)
+    s = samples["time"] * speed
+    keep = (s > 0.0) & (spread > 1e-6 * spread[1])
+    rate = -np.polyfit(s[keep], np.log(spread[keep]), 1)[0]
+    k, K = scene.wear.coefficient, scene.contact.stiffness_per_area
+    rows = [Row("tilted flat punch, archard", "decay rate of pressure differences", k * K, rate,
+                5e-2, "1/m")]
+    return Case("tilted_punch", VALIDATION / "tilted_punch.toml", rows,
+                {"distance": s, "spread": spread, "rate": k * K})
+
+
+def jenkins_quasi_static():
+    """Friction energy per cycle in quasi-static mode; nothing slips below mu N / K_t."""
+    scene = load_scene(VALIDATION / "jenkins_quasi_static.toml")
+    model, state, samples = _run(scene)
+    body = model.bodies[0]
+    osc = scene.bodies[0].path.oscillation
+    P, mu = _load(model, scene), scene.contact.friction
+    face = body.reference_vertices[:, 2] < body.reference_vertices[:, 2].min() + 1e-12
+    k_t = scene.contact.stiffness_per_area * _contact_area(body, samples["pose"][0])[face].sum()
+    expected = 4 * mu * P * (osc.amplitude - mu * P / k_t)
+    t, work = samples["time"], samples["friction_work"]
+    period = 1.0 / osc.frequency
+    edges = [int(np.abs(t - c * period).argmin()) for c in range(int(round(t[-1] / period)) + 1)]
+    per_cycle = np.diff(work[edges])[1:]   # the first cycle loads the springs from zero
+    worst = per_cycle[np.abs(per_cycle - expected).argmax()]
+    rows = [Row("Jenkins loop, quasi-static", "friction energy per cycle (worst of 2-5)",
+                expected, float(worst), 5e-3, "J")]
+    # below the slip amplitude: a quarter of mu N / K_t
+    small = dataclasses.replace(osc, amplitude=0.25 * mu * P / k_t)
+    body_config = dataclasses.replace(scene.bodies[0], path=dataclasses.replace(
+        scene.bodies[0].path, oscillation=small))
+    m2, s2, _ = _run(dataclasses.replace(scene, bodies=(body_config,)))
+    slipped = int((s2.bodies[0].contact_state == 2).sum())
+    below = "at a quarter of mu N / K_t:"
+    rows += [Row("Jenkins loop, quasi-static", f"{below} points slipping at the end", 0.0,
+                 float(slipped), 0.0, relative=False),
+             Row("Jenkins loop, quasi-static", f"{below} friction work", 0.0,
+                 float(s2.bodies[0].friction_work.sum()), 0.0, "J", relative=False),
+             Row("Jenkins loop, quasi-static", f"{below} worn volume", 0.0,
+                 float(s2.bodies[0].wear_volume.sum()), 0.0, "m³", relative=False)]
+    x = samples["pose"][:, 0] - samples["pose"][0, 0]
+    return Case("jenkins_quasi_static", VALIDATION / "jenkins_quasi_static.toml", rows,
+                {"x": x, "fx": samples["wrench"][:, 0], "mu_N": mu * P, "k_t": k_t,
+                 "amplitude": osc.amplitude})
+
+
+def pin_on_disc():
+    """A flat pin circling on a plane: V = k P s."""
+    scene = load_scene(EXAMPLES / "pin_on_disc.toml")
+    model, state, samples = _run(scene)
+    circle = scene.bodies[0].path.circle
+    distance = 2 * np.pi * circle.radius * circle.frequency * model.duration
+    k, P = scene.wear.coefficient, _load(model, scene)
+    rows = [Row("pin on disc, archard", "worn volume", k * P * distance,
+                float(state.bodies[0].wear_volume.sum()), 1e-2, "m³")]
+    return Case("pin_on_disc", EXAMPLES / "pin_on_disc.toml", rows,
+                {"time": samples["time"], "volume": samples["wear_volume"],
+                 "closed": k * P * 2 * np.pi * circle.radius * circle.frequency * samples["time"]})
+
+
+def mesh_independence(levels=(4, 5, 6), duration=2.0):
+    """The ball pin at three mesh levels, per area (Winkler + archard) and per
+    point (the published formulation: stiffness per point, `energy` law)."""
+    scene = load_scene(VALIDATION / "sphere_pin.toml")
+    out = {"levels": list(levels), "vertices": [], "per_area": [], "per_point": []}
+    # per point: the stiffness and energy coefficient that match the Winkler
+    # run on the middle level (its mean tributary area near the pole)
+    from meshwear import geometry
+
+    v, f = geometry.primitive("sphere", radius=scene.bodies[0].shape.radius,
+                              subdivisions=levels[1])
+    mean_area = geometry.tributary_areas(v, f).mean()
+    stiffness = scene.contact.stiffness_per_area * mean_area
+    energy_k = scene.wear.coefficient / (scene.contact.friction * mean_area)
+    for level in levels:
+        a = sphere_pin(subdivisions=level, duration=duration)
+        p = sphere_pin(subdivisions=level, duration=duration, stiffness=stiffness, law="energy",
+                       coefficient=energy_k)
+        out["vertices"].append(a.data["vertices"])
+        out["per_area"].append((a.rows[0].measured, a.rows[1].measured))
+        out["per_point"].append((p.rows[0].measured, p.rows[1].measured))
+    per_area = np.array(out["per_area"])
+    change = np.abs(per_area[-1] / per_area[-2] - 1)   # refining the finest level once more
+    rows = [Row("mesh independence (per area)", f"relative change of worn volume, level {levels[-2]} -> {levels[-1]}",
+                0.0, float(change[0]), 1e-2, "", relative=False),
+            Row("mesh independence (per area)", f"relative change of max depth, level {levels[-2]} -> {levels[-1]}",
+                0.0, float(change[1]), 1e-2, "", relative=False)]
+    return Case("mesh_independence", VALIDATION / "sphere_pin.toml", rows, out)
+
+
+ALL = (winkler_sphere, flat_pin, sphere_pin, tilted_punch, jenkins_quasi_static, pin_on_disc,
+       mesh_independence)
