@@ -1,17 +1,16 @@
 """Model (frozen: what a scene is) and State (what changes while it runs).
 
 :func:`build_model` turns a validated :class:`meshwear.scene.Scene` into plain
-arrays once; :func:`initial_state` allocates every array a run writes into, so
-a step allocates nothing. Kernels see only these arrays.
+
+
 """
 
-import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import geometry
-from .kernels.contact import make_law, plane_contact, rotation_entries
+from .kernels.contact import LAW_SLOTS, make_law, plane_contact, rotation_entries
 from .motion import BalancedMotion, FixedMotion, FreeMotion, GuidedMotion, Path, PrescribedMotion
 from .scene import SceneError
 
@@ -180,11 +179,6 @@ def build_model(scene):
     bodies = tuple(bodies)
     c = scene.contact
     (ct, ct_area), (dt_point, dt_area) = c.tangential
-    quasi_static = run.mode == "quasi-static"
-    if quasi_static:  # no inertia, so no damping either
-        c = dataclasses.replace(c, damping=0.0, damping_per_area=None, tangential_damping=0.0,
-                                tangential_damping_per_area=None)
-        dt_point, dt_area = 0.0, None
     law = make_law(friction=c.friction, static_friction=c.static_friction,
                    wear_law=scene.wear.law, wear_coefficient=scene.wear.coefficient, dt=dt,
                    stiffness=c.stiffness or 0.0, stiffness_per_area=c.stiffness_per_area or 0.0,
@@ -192,6 +186,9 @@ def build_model(scene):
                    tangential_stiffness=ct or 0.0, tangential_stiffness_per_area=ct_area or 0.0,
                    tangential_damping=dt_point or 0.0,
                    tangential_damping_per_area=dt_area or 0.0)
+    quasi_static = run.mode == "quasi-static"
+    if quasi_static:  # no inertia, so no damping either
+        law[[LAW_SLOTS.index(name) for name in LAW_SLOTS if "damping" in name]] = 0.0
     for j, (b, config) in enumerate(zip(bodies, scene.bodies)):
         if isinstance(b.motion, BalancedMotion):
             if not b.motion.settle(b.initial_pose, b.reference_vertices, b.area_vectors,

@@ -153,6 +153,7 @@ class BalancedMotion:
         self.path = path
         #: contact force the planes must supply along the axis (N)
         self.carried = -float(load)
+        self.scratch = np.zeros((2, 0))
 
     def place(self, pose, t):
         place_on_path(pose, self.start, self.path.terms, self.axis, pose[0:3] @ self.axis,
@@ -161,8 +162,11 @@ class BalancedMotion:
     def settle(self, pose, vertices, area_vectors, planes, law):
         """Move ``pose`` along the axis to the balance; False if no contact
         can carry the load."""
+        pairs = len(vertices) * planes.shape[0]
+        if self.scratch.shape[1] != pairs:
+            self.scratch = np.zeros((2, pairs))
         z = balance_offset(vertices, pose, self.axis, planes, area_vectors, law,
-                           self.carried, 0.0)
+                           self.carried, 0.0, self.scratch)
         if not np.isfinite(z):
             return False
         pose[0:3] += z * self.axis

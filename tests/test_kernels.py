@@ -256,13 +256,14 @@ def test_balance_offset_matches_numpy_twin(load, opposed):
     axis = np.array([0.1, -0.2, 1.0])
     axis /= np.linalg.norm(axis)
     expected = reference.balance_offset(vertices, pose, axis, planes, params, law, load)
+    scratch = np.zeros((2, 600))
     if not opposed and load < 0.0:
         # every plane faces the body from below: nothing can pull it down
         assert np.isnan(expected)
-        assert np.isnan(balance_offset(vertices, pose, axis, planes, params, law, load, 0.0))
+        assert np.isnan(balance_offset(vertices, pose, axis, planes, params, law, load, 0.0, scratch))
         return
     for guess in (0.0, -0.05, 0.05, expected):
-        z = balance_offset(vertices, pose, axis, planes, params, law, load, guess)
+        z = balance_offset(vertices, pose, axis, planes, params, law, load, guess, scratch)
         assert z == pytest.approx(expected, rel=1e-12, abs=1e-15)
     # the force at the solution is the load
     moved = pose.copy()
@@ -288,10 +289,11 @@ def test_balance_offset_refuses_a_load_nothing_can_carry():
     law = contact.make_law(friction=0.3, static_friction=0.3, wear_law="energy",
                            wear_coefficient=0.0, dt=1e-5, stiffness=1e6)
     up = np.array([0.0, 0.0, 1.0])
+    scratch = np.zeros((2, 1))
     # a plane under the point carries a load pressing down (contact pushes +z) ...
-    assert balance_offset(vertices, pose, up, planes, FACING_DOWN, law, 2.0, 0.0) == pytest.approx(-2e-6)
+    assert balance_offset(vertices, pose, up, planes, FACING_DOWN, law, 2.0, 0.0, scratch) == pytest.approx(-2e-6)
     # ... but nothing can pull it down: a load along -z has no carrier
-    assert np.isnan(balance_offset(vertices, pose, up, planes, FACING_DOWN, law, -2.0, 0.0))
+    assert np.isnan(balance_offset(vertices, pose, up, planes, FACING_DOWN, law, -2.0, 0.0, scratch))
     # and a free axis lying in the plane has no normal-force component at all
     assert np.isnan(balance_offset(vertices, pose, np.array([1.0, 0.0, 0.0]), planes, FACING_DOWN,
-                                   law, 2.0, 0.0))
+                                   law, 2.0, 0.0, scratch))

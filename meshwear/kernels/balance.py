@@ -77,18 +77,17 @@ def _force(z, breakpoint, weight, count):
 
 
 @njit(cache=True)
-def balance_offset(body_vertices, pose, axis, planes, area, law, load, guess):
+def balance_offset(body_vertices, pose, axis, planes, area, law, load, guess, scratch):
     """Offset ``z`` (m) along ``axis`` at which the contact normal forces on
     the body at ``pose`` add up to ``load`` (N) along ``axis``.
 
     Returns NaN when no contact can push the way ``load`` needs (no plane
     faces the body along the axis, or the load pulls it away from every
     plane). ``guess`` (m) warm-starts the iteration: the previous step's
-    offset is usually within one linear piece of the answer.
+    offset is usually within one linear piece of the answer. ``scratch`` is a
+    (2, n P) work array, so a step allocates nothing.
     """
-    n_pairs = body_vertices.shape[0] * planes.shape[0]
-    breakpoint = np.empty(n_pairs)
-    weight = np.empty(n_pairs)
+    breakpoint, weight = scratch[0], scratch[1]
     count = _pairs(body_vertices, pose, axis, planes, area, law, breakpoint, weight)
     # the side that must carry the load: pairs pushing along +axis for a
     # positive load (beta > 0), along -axis for a negative one
