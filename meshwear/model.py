@@ -1,8 +1,8 @@
 """Model (frozen: what a scene is) and State (what changes while it runs).
 
 :func:`build_model` turns a validated :class:`meshwear.scene.Scene` into plain
-
-
+arrays once; :func:`initial_state` allocates every per-vertex array a run
+writes into, so a step allocates no state. Kernels see only these arrays.
 """
 
 from dataclasses import dataclass, field
