@@ -92,6 +92,14 @@ class Model:
     sample_steps: np.ndarray
     frame_steps: np.ndarray
     period: float | None
+    #: steps per cycle when cycles are jumped over, else 0
+    cycle_steps: int = 0
+
+    def __post_init__(self):
+        steps = np.union1d(np.union1d(self.sample_steps, self.frame_steps), [self.n_steps])
+        object.__setattr__(self, "output_steps", steps.astype(np.int64))
+        object.__setattr__(self, "sample_set", set(self.sample_steps.tolist()))
+        object.__setattr__(self, "frame_set", set(self.frame_steps.tolist()))
 
     @property
     def duration(self):
@@ -131,9 +139,15 @@ class BodyState:
 
 @dataclass(eq=False)
 class State:
+    """Where a run is: ``step`` steps of ``dt`` represented (``time``), the
+    bodies' state, the last step whose outputs are written, and the cycle
+    jumping's bookkeeping (:class:`meshwear.wear.JumpState`, or None)."""
+
     time: float
     step: int
     bodies: list
+    written: int = -1
+    jump: object = None
 
 
 def build_model(scene):
@@ -146,9 +160,6 @@ def build_model(scene):
     """
     # parts of format 1 that this version reads but cannot carry out yet are
     # refused here, so no run silently does something other than asked
-    if scene.wear.acceleration != "none":
-        raise SceneError(scene.source, "wear.acceleration", f"{scene.wear.acceleration!r} is not "
-                         "supported by this version; use 'none' (every cycle resolved)")
     planes = []
     for j, s in enumerate(scene.surfaces):
         if s.type != "plane":
@@ -164,6 +175,9 @@ def build_model(scene):
     run = scene.run
     n_steps = max(1, int(np.ceil(run.duration / run.dt - 1e-9)))
     dt = run.duration / n_steps
+    cycle_steps = 0
+    if scene.wear.acceleration == "cycle_jump":
+        cycle_steps, dt, n_steps = _cycle_timing(scene)
     for key in ("frames", "history"):
         if getattr(run, key) > n_steps + 1:
             raise SceneError(scene.source, f"run.{key}", f"{getattr(run, key)} samples are more than "
@@ -207,7 +221,24 @@ def build_model(scene):
                    for p in planes)
     return Model(scene=scene, bodies=bodies, plane_list=planes, planes=plane_array, law=law,
                  quasi_static=quasi_static, dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
-                 frame_steps=_even_steps(n_steps, run.frames), period=period)
+                 frame_steps=_even_steps(n_steps, run.frames), period=period,
+                 cycle_steps=cycle_steps)
+
+
+def _cycle_timing(scene):
+    """Steps per cycle, dt and steps of a cycle-jumping run: dt is adjusted so
+    a cycle is a whole number of steps, and the duration rounded to whole steps."""
+    for j, b in enumerate(scene.bodies):
+        if b.motion == "free":
+            raise SceneError(scene.source, f"body[{j}].motion", "'free' bodies have no cycle to "
+                             "jump over; wear.acceleration = 'cycle_jump' needs guided, "
+                             "prescribed or fixed bodies")
+    periods = [Path(b.path).period for b in scene.bodies if b.path is not None]
+    period = scene.wear.period or max(p for p in periods if p is not None)
+    cycle_steps = max(1, int(round(period / scene.run.dt)))
+    dt = period / cycle_steps
+    n_steps = max(1, int(round(scene.run.duration / dt)))
+    return cycle_steps, dt, n_steps
 
 
 def _even_steps(n_steps, count):

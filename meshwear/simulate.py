@@ -60,7 +60,7 @@ def _quasi_static_step(model, state):
     state.time = state.step * model.dt
 
 
-def run(model, state, observers=(), progress=None):
+def run(model, state, observers=(), progress=None, checkpoint=None):
     """Run ``state`` from its current step to the end of ``model``'s duration.
 
     Parameters
@@ -75,6 +75,9 @@ def run(model, state, observers=(), progress=None):
     progress : callable, optional
         ``progress(step, n_steps)``, called at least every
         :data:`PROGRESS_STEPS` steps and at every sample.
+    checkpoint : callable, optional
+        ``checkpoint(model, state)``, called at points where the state can be
+        saved and resumed from (every output written up to its step).
 
     Raises
     ------
@@ -82,27 +85,46 @@ def run(model, state, observers=(), progress=None):
         When a sample finds NaN, an unbounded state or inverted triangles; the
         observers have seen every sample before it.
     """
-    samples = set(model.sample_steps.tolist())
-    frames = set(model.frame_steps.tolist())
-    checkpoints = sorted(samples | frames | {model.n_steps})
-    face_normals = [b.reference_face_normals for b in model.bodies]
-    for stop in checkpoints:
-        while state.step < stop:
-            # in chunks, so the progress report moves between sparse samples
-            until = min(stop, state.step + PROGRESS_STEPS)
-            while state.step < until:
-                step(model, state)
-            if progress is not None:
-                progress(state.step, model.n_steps)
-        if state.step in samples or state.step in frames:
-            check(model, state, face_normals)
-        if state.step in samples:
-            for o in observers:
-                o.on_sample(model, state)
-        if state.step in frames:
-            for o in observers:
-                o.on_frame(model, state)
+    if model.cycle_steps:
+        from .wear import run_cycle_jump
+
+        return run_cycle_jump(model, state, observers, progress, checkpoint)
+    advance(model, state, model.n_steps, observers, progress, checkpoint)
     return state
+
+
+def advance(model, state, stop, observers=(), progress=None, checkpoint=None):
+    """Step ``state`` up to step ``stop``, writing every output due on the way
+    (those of the current step first, unless already written)."""
+    schedule = model.output_steps
+    while True:
+        if state.step > state.written:
+            _write_outputs(model, state, observers)
+            if checkpoint is not None:
+                checkpoint(model, state)
+        if state.step >= stop:
+            return
+        following = schedule[np.searchsorted(schedule, state.step, side="right")]
+        until = min(stop, following, state.step + PROGRESS_STEPS)
+        while state.step < until:
+            step(model, state)
+        if progress is not None:
+            progress(state.step, model.n_steps)
+
+
+def _write_outputs(model, state, observers):
+    """Check the state and call the observers due at its step."""
+    at = state.step
+    sample, frame = at in model.sample_set, at in model.frame_set
+    if sample or frame:
+        check(model, state, [b.reference_face_normals for b in model.bodies])
+    if sample:
+        for o in observers:
+            o.on_sample(model, state)
+    if frame:
+        for o in observers:
+            o.on_frame(model, state)
+    state.written = at
 
 
 def check(model, state, face_normals):

@@ -6,6 +6,7 @@ Physics never writes files; :func:`meshwear.simulate.run` calls
 
 from pathlib import Path
 
+from ..wear import error_estimate
 from .fields import body_quantities
 from .tables import HISTORY_COLUMNS, HistoryWriter, write_json_atomic
 from .vtk import PVDSeries, plane_patch
@@ -76,6 +77,12 @@ def summary(model, state, wall_time, status="ok", message=None):
         "wall_time": wall_time,
         "bodies": {},
     }
+    if state.jump is not None:
+        out["resolved_cycles"] = state.jump.resolved_steps * model.dt / model.period
+        out["resolved_steps"] = state.jump.resolved_steps
+        out["jumps"] = state.jump.jumps
+        out["error_estimate"] = error_estimate(state)
+        out["jump_limits"] = dict(state.jump.limits)
     if message:
         out["message"] = message
     for body, s in zip(model.bodies, state.bodies):

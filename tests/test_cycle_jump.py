@@ -1,0 +1,147 @@
+"""Cycle jumping (DESIGN.md §4): the jump controller, its accuracy against
+fully resolved runs, and the hard case a volume check cannot see."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import cases
+from meshwear.model import build_model, initial_state
+from meshwear.scene import load_scene
+from meshwear.simulate import run, run_scene
+from meshwear.wear import GROWTH, THETA, choose_jump, error_estimate, run_cycle_jump
+
+
+# ---------------------------------------------------------------- controller
+
+def test_first_measurement_never_jumps():
+    rate = np.full(4, 1e-9)
+    assert choose_jump(rate, None, 1.0, rate, np.full(4, 1e-6), 0.01, 0, 100)[0] == 0
+
+
+def test_stability_bound_keeps_each_jump_under_theta_of_the_penetration():
+    rate = np.array([1e-9, 2e-9, 1e-12])          # wear per cycle (m)
+    pen = np.array([1e-6, 1e-6, 1e-9])            # elastic penetration (m)
+    jump, which = choose_jump(rate, rate.copy(), 1.0, 10 * rate, pen, 0.01, 10_000, 10_000)
+    assert which == "stability"
+    # the fastest of the significant vertices sets it: 0.3 x 1e-6 / 2e-9 = 150
+    assert jump == int(THETA * 1e-6 / 2e-9)
+
+
+def test_accuracy_bound_follows_the_change_of_the_rate():
+    previous = np.array([1.0e-9, 1.0e-9])
+    rate = np.array([1.0e-9, 1.1e-9])             # 1e-10 per cycle over 1 cycle
+    jump, which = choose_jump(rate, previous, 1.0, rate, np.full(2, 1.0), 0.01, 10_000, 10_000)
+    assert which == "accuracy"
+    assert jump == int(2 * 0.01 * 1.1e-9 / 1e-10)   # 2 tol r_max / |rho| = 0.22 -> 0
+    jump, _ = choose_jump(rate, previous, 100.0, rate, np.full(2, 1.0), 0.01, 10_000, 10_000)
+    assert jump == int(2 * 0.01 * 1.1e-9 / 1e-12)   # the same change over 100 cycles: 22
+
+
+def test_growth_and_output_bounds():
+    rate = np.full(3, 1e-9)
+    steady = dict(previous=rate.copy(), gap=1.0, depth=rate, penetration_=np.full(3, 1.0),
+                  tolerance=0.01)
+    assert choose_jump(rate, last_jump=7, limit=10_000, **steady) == (int(GROWTH * 7 + 1), "growth")
+    assert choose_jump(rate, last_jump=7, limit=3, **steady) == (3, "output")
+
+
+# ---------------------------------------------------------------- against resolved runs
+
+def _scene(path, **wear):
+    scene = load_scene(path)
+    return dataclasses.replace(scene, wear=dataclasses.replace(scene.wear, **wear))
+
+
+@pytest.fixture(scope="module")
+def punch():
+    """The tilted punch with a 0.5 mm cycle (k K s per cycle = 0.05), resolved
+    and jumped."""
+    scene = _scene(cases.VALIDATION / "tilted_punch.toml", acceleration="cycle_jump",
+                   period=0.01, tolerance=0.01)
+    scene = dataclasses.replace(scene, run=dataclasses.replace(scene.run, frames=0, history=3))
+    reference = build_model(dataclasses.replace(scene, wear=dataclasses.replace(
+        scene.wear, acceleration="none")))
+    ref_state = run(reference, initial_state(reference))
+    out = {"ref": (reference, ref_state)}
+    for label, forced in (("adaptive", None), ("forced", 50)):
+        model = build_model(scene)
+        state = initial_state(model)
+        run_cycle_jump(model, state, forced_jump=forced)
+        out[label] = (model, state)
+    return out
+
+
+def _spread(model, state):
+    body, s = model.bodies[0], state.bodies[0]
+    face = body.reference_vertices[:, 2] < body.reference_vertices[:, 2].min() + 1e-12
+    p = s.normal_force[0][face] / cases._contact_area(body, s.pose)[face]
+    return p.max() - p.min()
+
+
+def test_adaptive_jumps_follow_the_resolved_profile(punch, measured):
+    (_, ref), (model, state) = punch["ref"], punch["adaptive"]
+    error = np.abs(state.bodies[0].wear_depth - ref.bodies[0].wear_depth).max()
+    relative = error / ref.bodies[0].wear_depth.max()
+    measured("punch, jumped: profile error / max depth", relative, 0.0, 1e-2)
+    assert relative < model.scene.wear.tolerance
+    assert state.jump.resolved_steps < 0.3 * model.n_steps
+    assert 0.0 < error_estimate(state) < model.scene.wear.tolerance
+
+
+def test_forced_large_jumps_oscillate_while_the_volume_looks_right(punch, measured):
+    """J k K s = 2.5 per jump: each jump overshoots the pressure relief, so the
+    tilt of the pressure flips and grows instead of decaying as exp(-k K s);
+    the worn volume stays k P s because the load is always P."""
+    (ref_model, ref), (model, state) = punch["ref"], punch["forced"]
+    k, load = model.scene.wear.coefficient, 10.0
+    distance = 0.05 * model.duration
+    volume = state.bodies[0].wear_volume.sum()
+    assert volume == pytest.approx(k * load * distance, rel=1e-6)          # the volume is fine
+    initial = 1e13 * 5e-7 * 0.01       # K x tilt x face width
+    assert _spread(ref_model, ref) < 0.01 * initial                         # resolved: decayed
+    assert _spread(model, state) > 0.5 * initial                            # forced: it did not
+    profile = (np.abs(state.bodies[0].wear_depth - ref.bodies[0].wear_depth).max()
+               / ref.bodies[0].wear_depth.max())
+    measured("forced J=50 (want >5%): profile", profile, 0.0, 5e-2)
+    assert profile > 0.05
+    # the adaptive controller would not take such a jump: stability bounds it
+    adaptive = punch["adaptive"][1]
+    assert adaptive.jump.limits["stability"] > 0 or adaptive.jump.last_jump < 50
+
+
+def test_quasi_static_fretting_jumped_against_resolved(measured):
+    scene = _scene(cases.VALIDATION / "sphere_pin.toml", coefficient=6e-14,
+                   acceleration="cycle_jump", period=0.1, tolerance=0.01)
+    scene = dataclasses.replace(scene, run=dataclasses.replace(scene.run, duration=60.0,
+                                                                 frames=3, history=7))
+    resolved = dataclasses.replace(scene, wear=dataclasses.replace(scene.wear,
+                                                                   acceleration="none"))
+    _, ref, ref_history = run_scene(resolved)
+    model, state, history = run_scene(scene)
+    w, w_ref = state.bodies[0].wear_depth, ref.bodies[0].wear_depth
+    measured("ball, jumped: max depth vs resolved", w.max(), w_ref.max(), 1e-2)
+    assert w.max() == pytest.approx(w_ref.max(), rel=1e-2)
+    assert np.abs(w - w_ref).max() < 1e-2 * w_ref.max()
+    assert state.bodies[0].wear_volume.sum() == pytest.approx(6e-14 * 10.0 * 60.0, rel=1e-3)
+    # the history rows land at the times asked
+    np.testing.assert_allclose(history.rows["ball"]["time"], ref_history.rows["ball"]["time"],
+                               rtol=0, atol=1e-12)
+    assert state.jump.resolved_steps * 3 < model.n_steps
+
+
+def test_dynamic_guided_block_jumped_against_resolved(measured):
+    """The reciprocating block with inertia: after each jump one cycle settles
+    the contact, the next is measured."""
+    scene = load_scene(cases.EXAMPLES / "reciprocating_block.toml")
+    scene = dataclasses.replace(scene, run=dataclasses.replace(scene.run, duration=1.0, frames=0,
+                                                                 history=3))
+    _, ref, _ = run_scene(scene)
+    jumped = dataclasses.replace(scene, wear=dataclasses.replace(scene.wear,
+                                                                 acceleration="cycle_jump"))
+    model, state, _ = run_scene(jumped)
+    depth, depth_ref = state.bodies[0].wear_depth.max(), ref.bodies[0].wear_depth.max()
+    measured("block (dynamic), jumped: max depth", depth, depth_ref, 1e-2)
+    assert depth == pytest.approx(depth_ref, rel=1e-2)
+    assert state.jump.jumps > 0 and state.jump.resolved_steps < 0.7 * model.n_steps
