@@ -24,6 +24,11 @@ def main(argv=None):
     p.add_argument("scene", help="scene file (TOML, format 1)")
     p.add_argument("-o", "--out", default=None, help="output folder (default: out/<scene name>)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--resume", action="store_true",
+                   help="continue the stopped run in OUT from its last checkpoint")
+    p.add_argument("--checkpoint-every", type=float, default=60.0, metavar="SECONDS",
+                   help="save a checkpoint at most this often (wall clock; default 60, 0: as "
+                        "often as possible)")
     p = sub.add_parser("check", help="validate a scene and estimate its cost")
     p.add_argument("scene")
     p = sub.add_parser("demo", help="run the built-in demo scene")
@@ -43,7 +48,9 @@ def main(argv=None):
 
     try:
         if args.command == "run":
-            return _run(args.scene, args.out, args.quiet)
+            if args.checkpoint_every < 0:
+                raise InputError(f"--checkpoint-every: must be >= 0, got {args.checkpoint_every:g}")
+            return _run(args.scene, args.out, args.quiet, args.resume, args.checkpoint_every)
         if args.command == "demo":
             from importlib.resources import files
 
@@ -69,27 +76,37 @@ def _prepare(scene_path):
     return scene, model, check_time_step(model)
 
 
-def _run(scene_path, out, quiet):
+def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0):
+    from . import checkpoint
     from .model import initial_state
     from .output.recorder import RunRecorder, summary
     from .simulate import NumericalError, run
 
     scene, model, _ = _prepare(scene_path)
     out_dir = Path(out) if out else Path("out") / Path(scene_path).stem
-    start = time.perf_counter()
     state = initial_state(model)
+    wall_before = 0.0
+    if resume:
+        wall_before = checkpoint.load(out_dir / checkpoint.FILE_NAME, model, state)
+    saver = checkpoint.Checkpointer(out_dir, checkpoint_every, wall_before)
     try:
-        recorder = RunRecorder(out_dir, model)
+        recorder = RunRecorder(out_dir, model, resume_until=state.time if resume else None)
     except OSError as err:  # e.g. -o names an existing file, or a folder we may not write
         raise InputError(f"{out_dir}: output folder: cannot write there "
                          f"({err.strerror or err})") from None
+    except ValueError as err:  # resuming into files that are not this run's
+        raise InputError(f"{out_dir}: cannot resume: {err}") from None
+    if not resume:
+        saver.remove()   # a checkpoint of an earlier run in OUT no longer applies
+    if resume and not quiet:
+        print(f"resuming at t = {state.time:.6g} s (step {state.step} of {model.n_steps})")
     progress = None if quiet or not sys.stderr.isatty() else _ProgressBar(model)
     try:
-        run(model, state, observers=[recorder], progress=progress)
+        run(model, state, observers=[recorder], progress=progress, checkpoint=saver)
     except KeyboardInterrupt:
         if progress:
             progress.finish()
-        recorder.close(summary(model, state, time.perf_counter() - start, "interrupted",
+        recorder.close(summary(model, state, saver.wall_time, "interrupted",
                                f"interrupted at t = {state.time:.6g} s"))
         raise
     except OSError as err:  # the disk filled up, or the folder went away, mid-run
@@ -101,14 +118,15 @@ def _run(scene_path, out, quiet):
     except NumericalError as err:
         if progress:
             progress.finish()
-        recorder.close(summary(model, state, time.perf_counter() - start, "numerical_error", str(err)))
+        recorder.close(summary(model, state, saver.wall_time, "numerical_error", str(err)))
         print(f"meshwear: run stopped: {err}", file=sys.stderr)
         print(f"meshwear: outputs up to t = {state.time:.6g} s are in {out_dir}", file=sys.stderr)
         return EXIT_NUMERICAL
     if progress:
         progress.finish()
-    elapsed = time.perf_counter() - start
+    elapsed = saver.wall_time
     recorder.close(summary(model, state, elapsed))
+    saver.remove()
     if not quiet:
         print(f"done in {elapsed:.1f} s: {model.n_steps} steps, "
               f"{len(model.frame_steps)} frames")

@@ -98,6 +98,7 @@ class Model:
     def __post_init__(self):
         steps = np.union1d(np.union1d(self.sample_steps, self.frame_steps), [self.n_steps])
         object.__setattr__(self, "output_steps", steps.astype(np.int64))
+        object.__setattr__(self, "output_steps_set", set(steps.tolist()))
         object.__setattr__(self, "sample_set", set(self.sample_steps.tolist()))
         object.__setattr__(self, "frame_set", set(self.frame_steps.tolist()))
 

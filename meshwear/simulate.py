@@ -110,6 +110,8 @@ def advance(model, state, stop, observers=(), progress=None, checkpoint=None):
             step(model, state)
         if progress is not None:
             progress(state.step, model.n_steps)
+        if checkpoint is not None and state.step not in model.output_steps_set:
+            checkpoint(model, state)
 
 
 def _write_outputs(model, state, observers):

@@ -23,13 +23,17 @@ class RunRecorder:
     ----------
     out_dir : path
     model : meshwear.model.Model
+    resume_until : float, optional
+        Continue the files of a stopped run, keeping what it wrote up to this
+        time (s) and dropping the rest.
     """
 
-    def __init__(self, out_dir, model):
+    def __init__(self, out_dir, model, resume_until=None):
         self.out_dir = Path(out_dir)
         self.out_dir.mkdir(parents=True, exist_ok=True)
-        self.series = {b.name: PVDSeries(self.out_dir, b.name, b.faces) for b in model.bodies}
-        self.history = HistoryWriter(self.out_dir / "history.csv", EXTRA_COLUMNS)
+        self.series = {b.name: PVDSeries(self.out_dir, b.name, b.faces, resume_until)
+                       for b in model.bodies}
+        self.history = HistoryWriter(self.out_dir / "history.csv", EXTRA_COLUMNS, resume_until)
         for plane in model.plane_list:
             vertices, faces = plane_patch(plane.point, plane.normal, plane.size)
             patch = PVDSeries(self.out_dir, plane.name, faces)

@@ -29,15 +29,31 @@ class HistoryWriter:
         Columns after :data:`HISTORY_COLUMNS`.
     """
 
-    def __init__(self, path, extra_columns=()):
+    def __init__(self, path, extra_columns=(), resume_until=None):
         self.columns = tuple(HISTORY_COLUMNS) + tuple(extra_columns)
         if len(set(self.columns)) != len(self.columns):
             raise ValueError(f"duplicate history columns in {self.columns}")
         self.path = Path(path)
+        if resume_until is not None:
+            self._keep_rows_until(resume_until)
+            self._file = open(self.path, "a", newline="", encoding="utf-8")
+            self._csv = csv.writer(self._file, lineterminator="\n")
+            return
         self._file = open(self.path, "w", newline="", encoding="utf-8")
         self._csv = csv.writer(self._file, lineterminator="\n")
         self._csv.writerow(self.columns)
         self._file.flush()
+
+    def _keep_rows_until(self, time):
+        """Resuming: drop the rows written after ``time`` (s) by the stopped run."""
+        with open(self.path, newline="", encoding="utf-8") as f:
+            rows = list(csv.reader(f))
+        if not rows or tuple(rows[0]) != self.columns:
+            raise ValueError(f"{self.path}: not the history of this run (columns differ)")
+        limit = time + 1e-12 * max(1.0, abs(time))
+        kept = [r for r in rows[1:] if len(r) == len(self.columns) and float(r[0]) <= limit]
+        lines = [",".join(self.columns)] + [",".join(r) for r in kept]
+        write_text_atomic(self.path, "\n".join(lines) + "\n")
 
     def write(self, row):
         """Append one row.

@@ -29,7 +29,7 @@ class PVDSeries:
     faces : (m, 3) int
     """
 
-    def __init__(self, out_dir, name, faces):
+    def __init__(self, out_dir, name, faces, resume_until=None):
         name = str(name)
         if not name or name in (".", "..") or re.search(r"[/\\\x00]", name):
             raise ValueError(f"series name {name!r}: must be non-empty and contain no path separators")
@@ -42,11 +42,13 @@ class PVDSeries:
         self.frame_dir = self.out_dir / name
         self.pvd_path = self.out_dir / f"{name}.pvd"
         self.frame_dir.mkdir(parents=True, exist_ok=True)
+        # resuming keeps the frames up to ``resume_until`` (s) of the stopped run
+        self._entries = self._read_entries(resume_until) if resume_until is not None else []
+        kept = {Path(f).name for _, f in self._entries}
         stale = re.compile(re.escape(name) + r"_\d{5,}\.vtp")
         for old in self.frame_dir.iterdir():
-            if stale.fullmatch(old.name):
+            if stale.fullmatch(old.name) and old.name not in kept:
                 old.unlink()
-        self._entries = []          # (time, relative file name)
         self._closed = False
         self._write_pvd()           # an empty collection replaces any older series
 
@@ -93,6 +95,16 @@ class PVDSeries:
         self._entries.append((float(time), relative))
         self._write_pvd()
         return path
+
+    def _read_entries(self, until):
+        import xml.etree.ElementTree as ET
+
+        if not self.pvd_path.is_file():
+            return []
+        limit = until + 1e-12 * max(1.0, abs(until))
+        entries = [(float(d.get("timestep")), d.get("file"))
+                   for d in ET.parse(self.pvd_path).getroot().iter("DataSet")]
+        return [(t, f) for t, f in entries if t <= limit and (self.out_dir / f).is_file()]
 
     def _write_pvd(self):
         lines = ['<?xml version="1.0"?>',

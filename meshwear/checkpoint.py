@@ -1,0 +1,138 @@
+"""Checkpoints: save a running state atomically, and resume from it.
+
+A checkpoint holds everything that changes while a run runs (the
+:class:`meshwear.model.State`, cycle-jumping bookkeeping included) plus a
+digest of the scene and mesh files it belongs to; the model is rebuilt from
+the scene. It is taken only where a run can continue exactly as if never
+stopped: after the outputs of its step are written (and flushed), and in
+cycle-jumping runs at a cycle boundary. So a run killed at any moment and
+resumed ends with the same numbers as one that was never interrupted.
+"""
+
+import hashlib
+import os
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .scene import SceneError
+
+FILE_NAME = "checkpoint.npz"
+_BODY_ARRAYS = ("pose", "vertices", "wear_depth", "friction_work", "wear_volume",
+                "contact_state", "tangential", "normal_force", "wrench")
+
+
+def scene_digest(scene):
+    """SHA-256 of the scene file and every mesh file it reads."""
+    h = hashlib.sha256()
+    paths = [Path(scene.source)] + [Path(b.mesh) for b in scene.bodies if b.mesh is not None]
+    for path in paths:
+        if path.is_file():
+            h.update(path.read_bytes())
+    return h.hexdigest()
+
+
+def save(path, model, state, wall_time):
+    """Write ``state`` to ``path`` atomically (a reader sees the old or the new file)."""
+    arrays = {"digest": np.array(scene_digest(model.scene)),
+              "scalars": np.array([state.time, state.step, state.written, wall_time], dtype=float)}
+    for k, s in enumerate(state.bodies):
+        for name in _BODY_ARRAYS:
+            arrays[f"body{k}_{name}"] = getattr(s, name)
+    js = state.jump
+    if js is not None:
+        arrays["jump_scalars"] = np.array([js.gap, js.last_jump, js.jumps, js.resolved_steps,
+                                           float(js.settling)])
+        arrays["jump_limits"] = np.array([f"{k}={v}" for k, v in js.limits.items()])
+        for k, (rate, error) in enumerate(zip(js.rate, js.error)):
+            arrays[f"jump{k}_error"] = error
+            if rate is not None:
+                arrays[f"jump{k}_rate"] = rate
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            np.savez(f, **arrays)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def load(path, model, state):
+    """Fill ``state`` (from :func:`meshwear.model.initial_state`) from the
+    checkpoint at ``path``; return the wall time spent before it.
+
+    Raises
+    ------
+    SceneError
+        When the checkpoint is missing, unreadable, or belongs to other scene
+        or mesh files.
+    """
+    from .wear import JumpState
+
+    path = Path(path)
+    if not path.is_file():
+        raise SceneError(model.scene.source, "", f"no checkpoint in {path.parent} to resume from "
+                         "(run without --resume)")
+    try:
+        data = np.load(path, allow_pickle=False)
+        digest = str(data["digest"])
+    except (OSError, ValueError, KeyError) as err:
+        raise SceneError(model.scene.source, "", f"{path}: unreadable checkpoint ({err})") from None
+    if digest != scene_digest(model.scene):
+        raise SceneError(model.scene.source, "", f"{path} was written for another version of this "
+                         "scene or its meshes; run without --resume to start again")
+    t, step, written, wall = data["scalars"]
+    state.time, state.step, state.written = float(t), int(step), int(written)
+    for k, s in enumerate(state.bodies):
+        for name in _BODY_ARRAYS:
+            getattr(s, name)[...] = data[f"body{k}_{name}"]
+    if "jump_scalars" in data:
+        gap, last, jumps, resolved, settling = data["jump_scalars"]
+        limits = {}
+        for item in data["jump_limits"]:
+            key, value = str(item).split("=")
+            limits[key] = int(value)
+        n = len(state.bodies)
+        state.jump = JumpState(
+            rate=[data[f"jump{k}_rate"].copy() if f"jump{k}_rate" in data else None
+                  for k in range(n)],
+            error=[data[f"jump{k}_error"].copy() for k in range(n)],
+            gap=float(gap), last_jump=int(last), jumps=int(jumps), resolved_steps=int(resolved),
+            settling=bool(settling), limits=limits)
+    return float(wall)
+
+
+class Checkpointer:
+    """Observer-side hook for :func:`meshwear.simulate.run`: saves the state at
+    most every ``every`` seconds of wall time (0: at every opportunity)."""
+
+    def __init__(self, out_dir, every, wall_before=0.0):
+        self.path = Path(out_dir) / FILE_NAME
+        self.every = float(every)
+        self.start = time.perf_counter()
+        self.wall_before = wall_before
+        self.last = self.start
+
+    @property
+    def wall_time(self):
+        return self.wall_before + time.perf_counter() - self.start
+
+    def __call__(self, model, state):
+        now = time.perf_counter()
+        if now - self.last >= self.every:
+            save(self.path, model, state, self.wall_time)
+            self.last = now
+
+    def remove(self):
+        """The run finished: its outputs are complete, nothing to resume."""
+        try:
+            self.path.unlink()
+        except FileNotFoundError:
+            pass
