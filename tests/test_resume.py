@@ -4,7 +4,6 @@ the same numbers as a run never interrupted (DESIGN.md §4, issue: 1e-9)."""
 import csv
 import dataclasses
 import json
-import os
 import signal
 import subprocess
 import sys
