@@ -25,6 +25,7 @@ def _dot(a, b):
 
 
 FACING = 1e-3
+REVERSAL_MARGIN = 1.0 + 1e-9
 
 
 def point_coefficients(area, law):
@@ -81,8 +82,8 @@ def plane_contact(body_vertices, pose, planes, area_vectors, law, wear_direction
         trial = F0 - ct[:, None] * e - dtan[:, None] * slip_v
         trial -= np.outer(trial @ n, n)
         trial_mag = np.linalg.norm(trial, axis=1)
-        # a point that reversed in this step keeps stick: its spring only unloads
-        exceeds = (trial_mag > f0 * load) & ~reversed_
+        # a point that reversed in this step slips again only past a margin
+        exceeds = trial_mag > f0 * load * np.where(reversed_, REVERSAL_MARGIN, 1.0)
         stick = touching & (state == STICK) & ~exceeds
         breaks = touching & (state == STICK) & exceeds
         v_old[breaks & (speed == 0.0)] = -trial[breaks & (speed == 0.0)]

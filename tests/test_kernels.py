@@ -297,3 +297,36 @@ def test_balance_offset_refuses_a_load_nothing_can_carry():
     # and a free axis lying in the plane has no normal-force component at all
     assert np.isnan(balance_offset(vertices, pose, np.array([1.0, 0.0, 0.0]), planes, FACING_DOWN,
                                    law, 2.0, 0.0, scratch))
+
+
+def test_a_reversal_step_longer_than_the_unloading_slips_again_at_once():
+    """A stiff spring and a coarse step: the step a slip reverses in carries
+    the point past the whole stick branch (2 f N / c_t), so it slips again in
+    that step, in the new direction, and its slip counts as dissipation."""
+    vertices = np.zeros((1, 3))
+    pose = np.zeros(13)
+    pose[3] = 1.0
+    pose[2] = -1e-6
+    planes = np.zeros((1, 3, 3))
+    planes[0, 1, 2] = 1.0
+    c = 1e6
+    law = contact.make_law(friction=0.5, static_friction=0.5, wear_law="energy",
+                           wear_coefficient=0.0, dt=1e-3, stiffness=c, tangential_stiffness=c)
+    a = dict(contact_state=np.zeros((1, 1), np.int8), tangential=np.zeros((1, 1, 4, 3)),
+             normal_force=np.zeros((1, 1)), friction_work=np.zeros(1), wear_depth=np.zeros(1),
+             wear_volume=np.zeros(1), wrench=np.zeros(6))
+    args = (vertices, pose, planes, FACING_DOWN, law, np.zeros((0, 3)))
+    for k in range(4):                        # 2 µm steps along +x: slips at f N = 0.5 N
+        pose[0], pose[7] = 2e-6 * k, 2e-3
+        _call(contact.plane_contact, *args, a)
+    assert a["contact_state"][0, 0] == contact.SLIP
+    work = a["friction_work"][0]
+    pose[0], pose[7] = 3e-6, -3e-3             # back 3 µm: unloading takes 2 f N / c = 1 µm
+    _call(contact.plane_contact, *args, a)
+    assert a["contact_state"][0, 0] == contact.SLIP
+    assert a["tangential"][0, 0, 2, 0] == pytest.approx(0.5)
+    assert a["friction_work"][0] - work == pytest.approx(0.5 * 3e-6)
+    # a turning point with only round-off motion keeps the stick branch
+    pose[7] = 1e-20
+    _call(contact.plane_contact, *args, a)
+    assert a["contact_state"][0, 0] == contact.STICK

@@ -80,6 +80,9 @@ def make_law(*, friction, static_friction, wear_law, wear_coefficient, dt,
     values = dict(locals())
     return np.array([float(values[name]) for name in LAW_SLOTS])
 
+#: relative margin on the static limit in the step a slip reverses in
+REVERSAL_MARGIN = 1.0 + 1e-9
+
 #: a vertex touches a plane only where its area vector, projected on the
 #: plane, exceeds this fraction of its length (its surface faces the plane)
 FACING = 1e-3
@@ -178,10 +181,12 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                 # slip velocity reversed: stick from the turning point, one
                 # step back, holding the slip force (Jenkins element: the
                 # force is continuous). F0 is that force at the current load,
-                # -f N l/|l|, and the spring only unloads from it, so this
-                # step keeps stick without a limit test: at a turning point
-                # that falls on a step the slip velocity is round-off, and a
-                # round-off excess of |F| over f0 N would skip a whole branch
+                # -f N l/|l|. The spring unloads from it and slips again in
+                # this same step only if the step carried it past -F0 (a stiff
+                # spring, a coarse step); the limit gets a margin of
+                # REVERSAL_MARGIN, because at a turning point that falls on a
+                # step the slip velocity is round-off, and a round-off excess
+                # of |F| over f0 N must not skip a whole stick branch
                 state = STICK
                 reversed_now = True
                 tangential[s, i, ANCHOR, 0] = ax - sx * dt
@@ -208,8 +213,8 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                 Fz = tangential[s, i, START_FORCE, 2] - ct * (ez - en * nz) - dtan * sz
                 Fn = Fx * nx + Fy * ny + Fz * nz
                 Fx, Fy, Fz = Fx - Fn * nx, Fy - Fn * ny, Fz - Fn * nz
-                limit = f0 * load
-                if not reversed_now and Fx * Fx + Fy * Fy + Fz * Fz > limit * limit:
+                limit = f0 * load * (REVERSAL_MARGIN if reversed_now else 1.0)
+                if Fx * Fx + Fy * Fy + Fz * Fz > limit * limit:
                     # eq. 4: static limit exceeded, slip in the direction the
                     # spring was dragged (or of the slip velocity if any)
                     state = SLIP
