@@ -157,6 +157,11 @@ def _check(scene_path):
               else "no stability limit (nothing integrated in time)")
     print(f"  dt {model.dt:.3g} s, {stable}, {model.n_steps} steps, "
           f"{len(model.frame_steps)} frames, {len(model.sample_steps)} history rows")
+    if model.cycle_steps:
+        cycles = model.n_steps / model.cycle_steps
+        print(f"  cycle jumping: {model.cycle_steps} steps per cycle, {cycles:.6g} cycles, "
+              f"tolerance {scene.wear.tolerance:g}; at least {len(model.output_steps)} cycles "
+              "are resolved (one per output)")
     state = initial_state(model)
     step(model, state)  # compile (or load the cached) kernels
     trial = min(model.n_steps, 200)
@@ -165,7 +170,8 @@ def _check(scene_path):
         step(model, state)
     per_step = (time.perf_counter() - start) / max(trial, 1)
     points = sum(len(b.tributary_area) for b in model.bodies) * max(1, model.planes.shape[0])
-    print(f"  estimated run time {per_step * model.n_steps:.3g} s "
+    full = "if every cycle were resolved " if model.cycle_steps else ""
+    print(f"  estimated run time {full}{per_step * model.n_steps:.3g} s "
           f"({per_step * 1e6:.3g} µs per step, {points / per_step:.3g} vertex-steps/s)")
     return EXIT_OK
 

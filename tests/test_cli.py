@@ -704,3 +704,11 @@ def test_check_of_a_quasi_static_scene_has_no_stability_limit(capsys, caplog):
     code, out, err = cli(capsys, caplog, "check", Path(__file__).parents[1] / "examples" / "pin_on_disc.toml")
     assert code == 0, err
     assert "mode quasi-static" in out and "no stability limit (quasi-static)" in out
+
+
+def test_check_of_a_cycle_jumping_scene_says_how_it_jumps(capsys, caplog):
+    scene = Path(__file__).parents[1] / "examples" / "long" / "sphere_fretting_1e5.toml"
+    code, out, err = cli(capsys, caplog, "check", scene)
+    assert code == 0, err
+    assert "cycle jumping: 20 steps per cycle, 100000 cycles, tolerance 0.01" in out
+    assert "if every cycle were resolved" in out
