@@ -68,8 +68,7 @@ def penetration(model, body, s):
     return out
 
 
-def choose_jump(rate, previous, gap, depth, penetration_, tolerance, last_jump, limit,
-                theta=THETA):
+def choose_jump(rate, previous, gap, penetration_, tolerance, last_jump, limit, theta=THETA):
     """Cycles to jump over, and which bound set it.
 
     Parameters
@@ -79,8 +78,8 @@ def choose_jump(rate, previous, gap, depth, penetration_, tolerance, last_jump, 
         (``previous`` None after the first).
     gap : float
         Cycles between those two measurements.
-    depth, penetration_ : (n,) float
-        Current wear depth and elastic penetration (m).
+    penetration_ : (n,) float
+        Elastic penetration at the end of the last resolved cycle (m).
     tolerance : float
         Relative error allowed on wear depth.
     last_jump, limit : int
@@ -141,13 +140,12 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
         jump, which = limit, "output"
         if forced_jump is not None:
             jump, which = min(limit, forced_jump), "forced"
-        for body, s, rate, previous in zip(model.bodies, state.bodies, rates, js.rate):
-            if forced_jump is not None:
-                break
-            j, w = choose_jump(rate, previous, js.gap, s.wear_depth, penetration(model, body, s),
-                               tolerance, js.last_jump, limit)
-            if j < jump:
-                jump, which = j, w
+        else:
+            for body, s, rate, previous in zip(model.bodies, state.bodies, rates, js.rate):
+                j, w = choose_jump(rate, previous, js.gap, penetration(model, body, s),
+                                   tolerance, js.last_jump, limit)
+                if j < jump:
+                    jump, which = j, w
         if jump > 0:
             # the slope criterion's own estimate of this jump's error, per vertex
             for error, rate, previous in zip(js.error, rates, js.rate):

@@ -17,13 +17,13 @@ from meshwear.wear import GROWTH, THETA, choose_jump, error_estimate, run_cycle_
 
 def test_first_measurement_never_jumps():
     rate = np.full(4, 1e-9)
-    assert choose_jump(rate, None, 1.0, rate, np.full(4, 1e-6), 0.01, 0, 100)[0] == 0
+    assert choose_jump(rate, None, 1.0, np.full(4, 1e-6), 0.01, 0, 100)[0] == 0
 
 
 def test_stability_bound_keeps_each_jump_under_theta_of_the_penetration():
     rate = np.array([1e-9, 2e-9, 1e-12])          # wear per cycle (m)
     pen = np.array([1e-6, 1e-6, 1e-9])            # elastic penetration (m)
-    jump, which = choose_jump(rate, rate.copy(), 1.0, 10 * rate, pen, 0.01, 10_000, 10_000)
+    jump, which = choose_jump(rate, rate.copy(), 1.0, pen, 0.01, 10_000, 10_000)
     assert which == "stability"
     # the fastest of the significant vertices sets it: 0.3 x 1e-6 / 2e-9 = 150
     assert jump == int(THETA * 1e-6 / 2e-9)
@@ -32,17 +32,16 @@ def test_stability_bound_keeps_each_jump_under_theta_of_the_penetration():
 def test_accuracy_bound_follows_the_change_of_the_rate():
     previous = np.array([1.0e-9, 1.0e-9])
     rate = np.array([1.0e-9, 1.1e-9])             # 1e-10 per cycle over 1 cycle
-    jump, which = choose_jump(rate, previous, 1.0, rate, np.full(2, 1.0), 0.01, 10_000, 10_000)
+    jump, which = choose_jump(rate, previous, 1.0, np.full(2, 1.0), 0.01, 10_000, 10_000)
     assert which == "accuracy"
     assert jump == int(2 * 0.01 * 1.1e-9 / 1e-10)   # 2 tol r_max / |rho| = 0.22 -> 0
-    jump, _ = choose_jump(rate, previous, 100.0, rate, np.full(2, 1.0), 0.01, 10_000, 10_000)
+    jump, _ = choose_jump(rate, previous, 100.0, np.full(2, 1.0), 0.01, 10_000, 10_000)
     assert jump == int(2 * 0.01 * 1.1e-9 / 1e-12)   # the same change over 100 cycles: 22
 
 
 def test_growth_and_output_bounds():
     rate = np.full(3, 1e-9)
-    steady = dict(previous=rate.copy(), gap=1.0, depth=rate, penetration_=np.full(3, 1.0),
-                  tolerance=0.01)
+    steady = dict(previous=rate.copy(), gap=1.0, penetration_=np.full(3, 1.0), tolerance=0.01)
     assert choose_jump(rate, last_jump=7, limit=10_000, **steady) == (int(GROWTH * 7 + 1), "growth")
     assert choose_jump(rate, last_jump=7, limit=3, **steady) == (3, "output")
 
