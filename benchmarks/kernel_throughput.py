@@ -1,6 +1,6 @@
 """Throughput of the contact + friction + wear kernel, in vertex-steps per second.
 
-Runs :func:`meshwear.kernels.contact.plane_contact` (numba, 1 and all threads)
+Runs :func:`meshwear.kernels.contact.contact` (numba, 1 and all threads)
 and its plain-numpy twin (tests/reference.py) on the same data: a flat grid of
 contact points pressed on a plane and sliding back and forth, so the points
 stick, slip and reverse like a real fretting contact. Compile time is reported
@@ -47,7 +47,8 @@ def make_case(n):
                            tangential_stiffness_per_area=1e12, tangential_damping_per_area=1e7)
     state = dict(contact_state=np.zeros((1, n), np.int8), tangential=np.zeros((1, n, 4, 3)),
                  normal_force=np.zeros((1, n)), friction_work=np.zeros(n), wear_depth=np.zeros(n),
-                 wear_volume=np.zeros(n), wrench=np.zeros(6))
+                 wear_volume=np.zeros(n), wrench=np.zeros(6),
+                 vertex_planes=contact.no_mesh_planes(n), active=contact.all_vertices(n))
     return vertices, pose, planes, params, law, np.zeros((0, 3)), state
 
 
@@ -59,7 +60,8 @@ def drive(kernel, case, steps):
         phase = 2 * np.pi * k / 200.0
         pose[0] = 2e-6 * np.sin(phase)
         pose[7] = 2e-6 * 2 * np.pi / (200 * 1e-5) * np.cos(phase)
-        kernel(vertices, pose, planes, params, law, direction, s["contact_state"], s["tangential"],
+        kernel(vertices, pose, planes, s["vertex_planes"], s["active"], params, law, direction,
+               s["contact_state"], s["tangential"],
                s["normal_force"], s["friction_work"], s["wear_depth"], s["wear_volume"], s["wrench"])
     return time.perf_counter() - start
 
@@ -89,12 +91,12 @@ def main():
     rows = []
     for n in args.sizes:
         numba.set_num_threads(1)
-        serial, compile_serial = measure(contact.plane_contact_serial, n, args.seconds)
+        serial, compile_serial = measure(contact.contact_serial, n, args.seconds)
         numba.set_num_threads(1)
-        par1, _ = measure(contact.plane_contact_parallel, n, args.seconds)
+        par1, _ = measure(contact.contact_parallel, n, args.seconds)
         numba.set_num_threads(threads)
-        par, compile_par = measure(contact.plane_contact_parallel, n, args.seconds)
-        twin, _ = measure(reference.plane_contact, n, args.seconds)
+        par, compile_par = measure(contact.contact_parallel, n, args.seconds)
+        twin, _ = measure(reference.contact, n, args.seconds)
         rows.append(dict(points=n, serial=serial, parallel_1=par1, parallel_all=par, numpy=twin,
                          first_call_s=max(compile_serial, compile_par)))
     print(f"{'points':>9} {'numba 1 thread':>15} {'numba 1T (prange)':>18} "

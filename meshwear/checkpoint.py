@@ -21,7 +21,7 @@ from .scene import SceneError
 
 FILE_NAME = "checkpoint.npz"
 _BODY_ARRAYS = ("pose", "vertices", "wear_depth", "friction_work", "wear_volume",
-                "contact_state", "tangential", "normal_force", "wrench")
+                "contact_state", "tangential", "normal_force", "wrench", "vertex_planes", "cull")
 
 
 def scene_digest(scene):
@@ -41,6 +41,7 @@ def save(path, model, state, wall_time):
     for k, s in enumerate(state.bodies):
         for name in _BODY_ARRAYS:
             arrays[f"body{k}_{name}"] = getattr(s, name)
+        arrays[f"body{k}_active"] = s.active
     js = state.jump
     if js is not None:
         arrays["jump_scalars"] = np.array([js.gap, js.last_jump, js.jumps, js.resolved_steps,
@@ -90,9 +91,14 @@ def load(path, model, state):
                          "scene or its meshes; run without --resume to start again")
     t, step, written, wall = data["scalars"]
     state.time, state.step, state.written = float(t), int(step), int(written)
-    for k, s in enumerate(state.bodies):
-        for name in _BODY_ARRAYS:
-            getattr(s, name)[...] = data[f"body{k}_{name}"]
+    try:
+        for k, s in enumerate(state.bodies):
+            for name in _BODY_ARRAYS:
+                getattr(s, name)[...] = data[f"body{k}_{name}"]
+            s.active = data[f"body{k}_active"].astype(np.int64)
+    except (KeyError, ValueError) as err:
+        raise SceneError(model.scene.source, "", f"{path} was written by another version of "
+                         f"meshwear ({err}); run without --resume to start again") from None
     if "jump_scalars" in data:
         gap, last, jumps, resolved, settling = data["jump_scalars"]
         limits = {}

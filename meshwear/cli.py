@@ -169,10 +169,13 @@ def _check(scene_path):
     for _ in range(trial):
         step(model, state)
     per_step = (time.perf_counter() - start) / max(trial, 1)
-    points = sum(len(b.tributary_area) for b in model.bodies) * max(1, model.planes.shape[0])
+    active = sum(len(s.active) for s in state.bodies)
+    total = sum(len(b.tributary_area) for b in model.bodies)
+    points = active * max(1, model.slots)
     full = "if every cycle were resolved " if model.cycle_steps else ""
     print(f"  estimated run time {full}{per_step * model.n_steps:.3g} s "
-          f"({per_step * 1e6:.3g} µs per step, {points / per_step:.3g} vertex-steps/s)")
+          f"({per_step * 1e6:.3g} µs per step, {points / per_step:.3g} vertex-steps/s; "
+          f"{active} of {total} vertices within reach of a surface)")
     return EXIT_OK
 
 

@@ -9,8 +9,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import geometry
-from .kernels.contact import LAW_SLOTS, make_law, plane_contact, rotation_entries
+from . import geometry, surfaces
+from .kernels.contact import LAW_SLOTS, all_vertices, contact, make_law, rotation_entries
 from .motion import BalancedMotion, FixedMotion, FreeMotion, GuidedMotion, Path, PrescribedMotion
 from .scene import SceneError
 
@@ -48,6 +48,8 @@ class BodyModel:
     motion : FreeMotion | GuidedMotion | PrescribedMotion | FixedMotion
     period : float or None
         Cycle length of the body's path (s).
+    radius : float
+        Largest distance of a vertex from the centre of mass (m).
     """
 
     name: str
@@ -63,6 +65,7 @@ class BodyModel:
     initial_pose: np.ndarray
     motion: object
     period: float | None
+    radius: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -78,7 +81,9 @@ class Model:
     """Everything about a run that does not change while it runs.
 
     ``planes`` is the (P, 3, 3) array the contact kernel takes (point, normal,
-    velocity per plane); ``law`` its (13,) contact and wear law.
+    velocity per plane); ``law`` its (13,) contact and wear law. ``surfaces``
+    holds the planes and the mesh counter-surfaces (slots ``P + m`` of the
+    per-pair arrays); ``cull`` says whether bodies keep an active set.
     """
 
     scene: object
@@ -94,6 +99,8 @@ class Model:
     period: float | None
     #: steps per cycle when cycles are jumped over, else 0
     cycle_steps: int = 0
+    surfaces: object = None
+    cull: bool = True
 
     def __post_init__(self):
         steps = np.union1d(np.union1d(self.sample_steps, self.frame_steps), [self.n_steps])
@@ -105,6 +112,11 @@ class Model:
     @property
     def duration(self):
         return self.n_steps * self.dt
+
+    @property
+    def slots(self):
+        """Number of counter-surfaces: planes, then meshes."""
+        return self.planes.shape[0] + (len(self.surfaces.meshes) if self.surfaces else 0)
 
 
 @dataclass(eq=False)
@@ -119,12 +131,19 @@ class BodyState:
         Worn vertices in the body frame (m).
     wear_depth, friction_work, wear_volume : (n,) float
         ``w`` (m), ``E`` (J) and worn volume (m³) per vertex.
-    contact_state : (P, n) int8
-    tangential : (P, n, 4, 3) float
+    contact_state : (S, n) int8
+        Per counter-surface (planes, then meshes).
+    tangential : (S, n, 4, 3) float
         Stick anchor, stick-start force, friction force, last slip velocity.
-    normal_force : (P, n) float
+    normal_force : (S, n) float
     wrench : (6,) float
         Contact force and torque about the centre of mass in the last step.
+    vertex_planes : (M, n, 3, 3) float
+        Per mesh surface, the plane of the face under each active vertex.
+    active : (k,) int64
+        The vertices within reach of a surface (:mod:`meshwear.surfaces`).
+    cull : (10,) float
+        Margin, time, pose and wear depth of the last active-set refresh.
     """
 
     pose: np.ndarray
@@ -136,6 +155,10 @@ class BodyState:
     tangential: np.ndarray
     normal_force: np.ndarray
     wrench: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    vertex_planes: np.ndarray = None
+    active: np.ndarray = None
+    cull: np.ndarray = None
+    cull_scratch: object = None
 
 
 @dataclass(eq=False)
@@ -161,11 +184,15 @@ def build_model(scene):
     """
     # parts of format 1 that this version reads but cannot carry out yet are
     # refused here, so no run silently does something other than asked
-    planes = []
+    planes, meshes = [], []
     for j, s in enumerate(scene.surfaces):
-        if s.type != "plane":
-            raise SceneError(scene.source, f"surface[{j}].type",
-                             "mesh counter-surfaces are not supported by this version; use a plane")
+        if s.type == "mesh":
+            try:
+                meshes.append(surfaces.build_mesh_surface(s, j, scene.source))
+            except geometry.MeshError as err:
+                key = f"surface[{j}].mesh" if s.mesh is not None else f"surface[{j}].shape"
+                raise SceneError(scene.source, key, str(err)) from None
+            continue
         planes.append(PlaneModel(s.name, np.asarray(s.point, float),
                                  np.asarray(s.normal, float), s.size))
     plane_array = np.zeros((len(planes), 3, 3))
@@ -204,16 +231,19 @@ def build_model(scene):
     quasi_static = run.mode == "quasi-static"
     if quasi_static:  # no inertia, so no damping either
         law[[LAW_SLOTS.index(name) for name in LAW_SLOTS if "damping" in name]] = 0.0
+    surface_set = surfaces.SurfaceSet(plane_array, meshes)
     for j, (b, config) in enumerate(zip(bodies, scene.bodies)):
+        vertex_planes = surfaces.initial_planes(surface_set, b, b.initial_pose, 2.0 * b.radius)[0]
         if isinstance(b.motion, BalancedMotion):
             if not b.motion.settle(b.initial_pose, b.reference_vertices, b.area_vectors,
-                                   plane_array, law):
+                                   plane_array, vertex_planes,
+                                   all_vertices(len(b.reference_vertices)), law):
                 raise SceneError(scene.source, f"body[{j}].path.free_axis",
                                  f"no surface can carry the load of body {config.name!r} along "
                                  f"{list(config.path.free_axis)} (the load pulls it off every "
-                                 "plane, or no plane faces it along that axis)")
+                                 "surface, or no surface faces it along that axis)")
         else:
-            _refuse_deep_start(scene, j, b, config, planes)
+            _refuse_deep_start(scene, j, b, config, planes, meshes, vertex_planes)
     periods = [b.period for b in bodies if b.period is not None]
     period = scene.wear.period or (max(periods) if periods else None)
     # a plane without a size is drawn 4 body extents wide
@@ -221,6 +251,7 @@ def build_model(scene):
     planes = tuple(p if p.size is not None else PlaneModel(p.name, p.point, p.normal, 4.0 * extent)
                    for p in planes)
     return Model(scene=scene, bodies=bodies, plane_list=planes, planes=plane_array, law=law,
+                 surfaces=surface_set,
                  quasi_static=quasi_static, dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
                  frame_steps=_even_steps(n_steps, run.frames), period=period,
                  cycle_steps=cycle_steps)
@@ -314,7 +345,7 @@ def _build_body(scene, index, body):
         wear_direction=wear_direction,
         reference_face_normals=geometry.face_normals(body_vertices, faces),
         mass=float(mass), inertia=inertia, origin=-com, initial_pose=pose, motion=motion,
-        period=path.period)
+        period=path.period, radius=float(np.linalg.norm(body_vertices, axis=1).max()))
 
 
 #: an initial penetration deeper than this fraction of the body's smallest
@@ -322,18 +353,20 @@ def _build_body(scene, index, body):
 START_PENETRATION = 0.01
 
 
-def _refuse_deep_start(scene, index, body, config, planes):
-    """A body placed deep inside a plane would be shot out by its first steps."""
+def _refuse_deep_start(scene, index, body, config, planes, meshes, vertex_planes):
+    """A body placed deep inside a surface would be shot out by its first steps."""
     R = np.array(rotation_entries(body.initial_pose[3:7])).reshape(3, 3)
     x = body.initial_pose[0:3] + body.reference_vertices @ R.T
     allowed = START_PENETRATION * float(np.ptp(body.reference_vertices, axis=0).min())
-    for p in planes:
-        depth = -float(((x - p.point) @ p.normal).min())
+    depths = [(p, -float(((x - p.point) @ p.normal).min())) for p in planes]
+    depths += [(m, -float(np.einsum("ij,ij->i", x - vp[:, 0], vp[:, 1]).min()))
+               for m, vp in zip(meshes, vertex_planes)]
+    for p, depth in depths:
         if depth > allowed:
             raise SceneError(scene.source, f"body[{index}].position",
                              f"body {config.name!r} starts {depth:.3g} m inside surface "
-                             f"{p.name!r}; place it on or above the plane (its normal points "
-                             "out of the solid side)")
+                             f"{p.name!r}; place it on or above the surface (a plane's normal, "
+                             "and a mesh's face normals, point out of the solid side)")
 
 
 def point_coefficients(model, body):
@@ -345,27 +378,39 @@ def point_coefficients(model, body):
 
 
 def initial_state(model):
-    """Allocate the :class:`State` of ``model`` at t = 0."""
-    P = model.planes.shape[0]
+    """Allocate the :class:`State` of ``model`` at t = 0, with each body's
+    active set."""
+    S, M = model.slots, len(model.surfaces.meshes)
     bodies = []
     for b in model.bodies:
         n = len(b.tributary_area)
         bodies.append(BodyState(
             pose=b.initial_pose.copy(), vertices=b.reference_vertices.copy(),
             wear_depth=np.zeros(n), friction_work=np.zeros(n), wear_volume=np.zeros(n),
-            contact_state=np.zeros((P, n), dtype=np.int8),
-            tangential=np.zeros((P, n, 4, 3)), normal_force=np.zeros((P, n))))
+            contact_state=np.zeros((S, n), dtype=np.int8),
+            tangential=np.zeros((S, n, 4, 3)), normal_force=np.zeros((S, n)),
+            vertex_planes=np.zeros((M, n, 3, 3)), active=all_vertices(n),
+            cull=np.zeros(surfaces.CULL_SIZE),
+            cull_scratch=surfaces.Cull(np.zeros(n), np.zeros((n, 3, 3)) if M else None)))
     state = State(time=0.0, step=0, bodies=bodies)
+    for body, s in zip(model.bodies, state.bodies):
+        surfaces.update(model, body, s, 0.0)
     if model.quasi_static:
         # the bodies already sit in balance at t = 0: evaluate their contacts
         # there (at rest, so nothing slips or wears), for the t = 0 outputs
         # and the stick anchors the first step starts from
         for body, s in zip(model.bodies, state.bodies):
             s.pose[7:13] = 0.0
-            plane_contact(s.vertices, s.pose, model.planes, body.area_vectors, model.law,
-                          body.wear_direction, s.contact_state, s.tangential, s.normal_force,
-                          s.friction_work, s.wear_depth, s.wear_volume, s.wrench)
+            body_contact(model, body, s)
     return state
+
+
+def body_contact(model, body, s):
+    """One step of the contact kernel for one body (planes and mesh surfaces,
+    its active vertices)."""
+    contact(s.vertices, s.pose, model.planes, s.vertex_planes, s.active, body.area_vectors,
+            model.law, body.wear_direction, s.contact_state, s.tangential, s.normal_force,
+            s.friction_work, s.wear_depth, s.wear_volume, s.wrench)
 
 
 def stable_time_step(model):
@@ -389,7 +434,7 @@ def stable_time_step(model):
             continue
         c, d, ct, dtan = point_coefficients(model, b)
         # a vertex may press on every plane at once (a box in a corner)
-        planes = max(1, model.planes.shape[0])
+        planes = max(1, model.slots)
         k, d = planes * np.maximum(c, ct), planes * np.maximum(d, dtan)
         if kind == "axis":
             K = np.array([[k.sum()]])

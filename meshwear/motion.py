@@ -159,14 +159,15 @@ class BalancedMotion:
         place_on_path(pose, self.start, self.path.terms, self.axis, pose[0:3] @ self.axis,
                       0.0, t, self.path.buffer)
 
-    def settle(self, pose, vertices, area_vectors, planes, law):
+    def settle(self, pose, vertices, area_vectors, planes, vertex_planes, active, law):
         """Move ``pose`` along the axis to the balance; False if no contact
-        can carry the load."""
-        pairs = len(vertices) * planes.shape[0]
-        if self.scratch.shape[1] != pairs:
+        can carry the load (arrays as for
+        :func:`meshwear.kernels.balance.balance_offset`)."""
+        pairs = len(active) * (planes.shape[0] + vertex_planes.shape[0])
+        if self.scratch.shape[1] < pairs:
             self.scratch = np.zeros((2, pairs))
-        z = balance_offset(vertices, pose, self.axis, planes, area_vectors, law,
-                           self.carried, 0.0, self.scratch)
+        z = balance_offset(vertices, pose, self.axis, planes, vertex_planes, active, area_vectors,
+                           law, self.carried, 0.0, self.scratch)
         if not np.isfinite(z):
             return False
         pose[0:3] += z * self.axis

@@ -21,7 +21,7 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .scene_checks import (SceneError, _choice, _did_you_mean, _direction, _exclusive,
+from .scene_checks import (SceneError, _boolean, _choice, _did_you_mean, _direction, _exclusive,
                            _instance, _integer, _name, _nonnegative, _positive, _real, _set,
                            _set_optional, _show, _vector)
 
@@ -39,7 +39,7 @@ SHAPE_KEYS = {"box": ("size",), "sphere": ("radius", "subdivisions"),
 SHAPE_REQUIRED = {"box": ("size",), "sphere": ("radius",), "cylinder": ("radius", "height")}
 PLANE_KEYS = ("point", "normal", "size")
 MESH_SURFACE_KEYS = ("mesh", "shape", "units", "resolution", "position", "orientation",
-                     "rotation", "path")
+                     "rotation", "path", "smooth_normals")
 
 
 def _check_mesh_or_shape(obj):
@@ -115,8 +115,12 @@ class ContactConfig:
     tangential_stiffness_per_area: float | None = None
     tangential_damping: float | None = None
     tangential_damping_per_area: float | None = None
+    #: m: vertices farther than this from every surface are skipped (active
+    #: set); None: 1 % of each body's bounding-box diagonal
+    margin: float | None = None
 
     def __post_init__(self):
+        _set_optional(self, "margin", _positive)
         for base, check in (("stiffness", _positive), ("damping", _nonnegative),
                             ("tangential_stiffness", _positive), ("tangential_damping", _nonnegative)):
             _exclusive(self, base, base + "_per_area")
@@ -356,10 +360,13 @@ class SurfaceConfig:
     orientation: tuple = (1.0, 0.0, 0.0, 0.0)
     rotation: RotationConfig | None = None
     path: PathConfig | None = None
+    #: interpolate vertex normals over the face under a vertex (curved parts)
+    smooth_normals: bool = False
 
     def __post_init__(self):
         _set(self, "name", _name)
         _set(self, "type", _choice, SURFACE_TYPES)
+        _set(self, "smooth_normals", _boolean)
         if self.type == "plane":
             _set(self, "point", _vector)
             _set(self, "normal", _direction)

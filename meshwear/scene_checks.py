@@ -77,6 +77,12 @@ def _nonnegative(key, value):
     return value
 
 
+def _boolean(key, value):
+    if not isinstance(value, bool):
+        raise SceneError("", key, f"expected true or false, got {_show(value)}")
+    return value
+
+
 def _integer(key, value, low, high=None):
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise SceneError("", key, f"expected an integer, got {_show(value)}")

@@ -8,8 +8,9 @@ the dynamics of every body from the contact wrench just computed.
 
 import numpy as np
 
+from . import surfaces
 from .geometry import inverted_faces
-from .kernels.contact import plane_contact
+from .model import body_contact
 from .output.memory import MemoryHistory
 
 
@@ -27,9 +28,8 @@ def step(model, state):
         _quasi_static_step(model, state)
         return
     for body, s in zip(model.bodies, state.bodies):
-        plane_contact(s.vertices, s.pose, model.planes, body.area_vectors, model.law,
-                      body.wear_direction, s.contact_state, s.tangential, s.normal_force,
-                      s.friction_work, s.wear_depth, s.wear_volume, s.wrench)
+        surfaces.update(model, body, s, state.time)
+        body_contact(model, body, s)
     for body, s in zip(model.bodies, state.bodies):
         body.motion.advance(s.pose, s.wrench, state.time, model.dt)
     state.step += 1
@@ -46,16 +46,21 @@ def _quasi_static_step(model, state):
     for body, s in zip(model.bodies, state.bodies):
         before = s.pose[0:3].copy()
         body.motion.place(s.pose, t)
-        settle = getattr(body.motion, "settle", None)
-        if settle is not None and not settle(s.pose, s.vertices, body.area_vectors,
-                                             model.planes, model.law):
-            raise NumericalError(f"body {body.name!r}: no contact carries its load at "
-                                 f"t = {t:.6g} s")
         s.pose[7:10] = (s.pose[0:3] - before) / model.dt
         s.pose[10:13] = 0.0
-        plane_contact(s.vertices, s.pose, model.planes, body.area_vectors, model.law,
-                      body.wear_direction, s.contact_state, s.tangential, s.normal_force,
-                      s.friction_work, s.wear_depth, s.wear_volume, s.wrench)
+        # the faces under the vertices where the path puts the body, then the
+        # balance along its free axis on their planes
+        surfaces.update(model, body, s, t)
+        settle = getattr(body.motion, "settle", None)
+        if settle is not None:
+            if not settle(s.pose, s.vertices, body.area_vectors, model.planes, s.vertex_planes,
+                          s.active, model.law):
+                raise NumericalError(f"body {body.name!r}: no contact carries its load at "
+                                     f"t = {t:.6g} s")
+            s.pose[7:10] = (s.pose[0:3] - before) / model.dt
+            if surfaces.moved_since_refresh(model, body, s, t) >= s.cull[surfaces.CULL_MARGIN]:
+                surfaces.update(model, body, s, t)
+        body_contact(model, body, s)
     state.step += 1
     state.time = state.step * model.dt
 

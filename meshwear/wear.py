@@ -29,7 +29,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .kernels.contact import ANCHOR, rotation_entries
+from .kernels.contact import ANCHOR
+from .surfaces import contact_areas, slot_normals
 
 #: largest wear in one jump, as a fraction of a vertex's elastic penetration
 THETA = 0.3
@@ -58,10 +59,9 @@ class JumpState:
 def penetration(model, body, s):
     """(n,) elastic penetration of each vertex at the end of the last step (m):
     its normal force over its normal stiffness, the largest over the planes."""
-    R = np.array(rotation_entries(s.pose[3:7])).reshape(3, 3)
     out = np.zeros(len(s.wear_depth))
-    for j in range(model.planes.shape[0]):
-        area = -(body.area_vectors[:, 0:3] @ R.T) @ model.planes[j, 1]
+    for j, normal in enumerate(slot_normals(model, s)):
+        area = contact_areas(body, s, normal)
         c = model.law[5] + model.law[6] * area
         loaded = (s.normal_force[j] > 0.0) & (c > 0.0)
         out[loaded] = np.maximum(out[loaded], s.normal_force[j][loaded] / c[loaded])
@@ -180,9 +180,9 @@ def _jump(model, state, before, rates, jump):
         start = s.pose[0:3].copy()
         body.motion.place(s.pose, state.time)
         moved = s.pose[0:3] - start
-        for j in range(model.planes.shape[0]):
-            n = model.planes[j, 1]
-            s.tangential[j, :, ANCHOR] += moved - (moved @ n) * n
+        for j, n in enumerate(slot_normals(model, s)):
+            n = np.broadcast_to(n, s.tangential[j, :, ANCHOR].shape)
+            s.tangential[j, :, ANCHOR] += moved - np.einsum("ij,j->i", n, moved)[:, None] * n
 
 
 def error_estimate(state):

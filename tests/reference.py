@@ -34,38 +34,45 @@ def point_coefficients(area, law):
 
 
 def contact_areas(area_vectors, R, n):
-    """(n,) contact area of each vertex against the plane of normal ``n``:
-    its world area vector projected on -n."""
-    return -(area_vectors[:, 0:3] @ R.T) @ n
+    """(n,) contact area of each vertex against the plane of normal ``n`` ((3,)
+    or one per vertex): its world area vector projected on -n."""
+    return -_dot(area_vectors[:, 0:3] @ R.T, np.broadcast_to(n, (len(area_vectors), 3)))
 
 
-def plane_contact(body_vertices, pose, planes, area_vectors, law, wear_direction,
-                  contact_state, tangential, normal_force, friction_work, wear_depth,
-                  wear_volume, wrench):
-    """Same contract as :func:`meshwear.kernels.contact.plane_contact`."""
+def contact(body_vertices, pose, planes, vertex_planes, active, area_vectors, law,
+            wear_direction, contact_state, tangential, normal_force, friction_work, wear_depth,
+            wear_volume, wrench):
+    """Same contract as :func:`meshwear.kernels.contact.contact`."""
     f, f0, wear_law, k, dt = law[0], law[1], int(law[2]), law[3], law[4]
     R = quaternion_matrix(pose[3:7])
     r = body_vertices @ R.T
     x = pose[0:3] + r
     u = pose[7:10] + np.cross(pose[10:13], r)
+    count = len(x)
     force = np.zeros_like(x)
     moves = np.zeros_like(x)
-    for s in range(planes.shape[0]):
-        p, n, vel = planes[s]
-        delta = (x - p) @ n
+    is_active = np.zeros(count, bool)
+    is_active[active] = True
+    slots = [np.broadcast_to(pl, (count, 3, 3)) for pl in planes] + list(vertex_planes)
+    for s, pl in enumerate(slots):
+        p, n, vel = pl[:, 0], pl[:, 1], pl[:, 2]
+        delta = _dot(x - p, n)
         area = contact_areas(area_vectors, R, n)
-        touching = (delta < 0.0) & (area > FACING * area_vectors[:, 3])
+        touching = is_active & (delta < 0.0) & (area > FACING * area_vectors[:, 3])
         c, d, ct, dtan = point_coefficients(area, law)
         safe_area = np.where(touching, area, 1.0)
         g = u - vel
-        rate = g @ n
-        slip_v = g - np.outer(rate, n)
+        rate = _dot(g, n)
+        slip_v = g - rate[:, None] * n
         load = np.where(touching, np.maximum(-(c * delta + d * rate), 0.0), 0.0)
-        on_plane = x - np.outer(delta, n)
+        on_plane = x - delta[:, None] * n
         T = tangential[s]
         state = contact_state[s].copy()
         anchor, F0, v_old = T[:, 0].copy(), T[:, 1].copy(), T[:, 3].copy()
 
+        # a sticking anchor is a point of the counter-surface: it moves with it
+        held = touching & (state == STICK)
+        anchor[held] += dt * vel[held]
         new = touching & (state == NO_CONTACT)
         anchor[new], F0[new], v_old[new] = on_plane[new], 0.0, slip_v[new]
         reversed_ = touching & (state == SLIP) & (_dot(slip_v, v_old) < 0.0)
@@ -78,9 +85,9 @@ def plane_contact(body_vertices, pose, planes, area_vectors, law, wear_direction
 
         speed = np.linalg.norm(slip_v, axis=1)
         e = on_plane - anchor
-        e -= np.outer(e @ n, n)
+        e -= _dot(e, n)[:, None] * n
         trial = F0 - ct[:, None] * e - dtan[:, None] * slip_v
-        trial -= np.outer(trial @ n, n)
+        trial -= _dot(trial, n)[:, None] * n
         trial_mag = np.linalg.norm(trial, axis=1)
         # a point that reversed in this step slips again only past a margin
         exceeds = trial_mag > f0 * load * np.where(reversed_, REVERSAL_MARGIN, 1.0)
@@ -105,17 +112,21 @@ def plane_contact(body_vertices, pose, planes, area_vectors, law, wear_direction
             dv = np.where(slip, k * load * speed * dt, 0.0)
             dw = dv / safe_area
 
-        direction = wear_direction if wear_direction.shape[0] else np.tile(R.T @ n, (len(dw), 1))
+        direction = wear_direction if wear_direction.shape[0] else n @ R
         if wear_direction.shape[0]:
             # a sticking point's anchor follows its foot on the plane as it wears
             along_plane = direction @ R.T
-            along_plane -= np.outer(along_plane @ n, n)
+            along_plane -= _dot(along_plane, n)[:, None] * n
             anchor += np.where(stick[:, None], dw[:, None] * along_plane, 0.0)
 
-        contact_state[s] = np.where(touching, np.where(slip, SLIP, STICK), NO_CONTACT)
-        normal_force[s] = load
-        T[:, 0], T[:, 1], T[:, 3] = anchor, F0, v_old
-        T[:, 2] = F
+        keep = ~is_active
+        contact_state[s] = np.where(keep, contact_state[s],
+                                    np.where(touching, np.where(slip, SLIP, STICK), NO_CONTACT))
+        normal_force[s] = np.where(keep, normal_force[s], load)
+        T[:, 0] = np.where(keep[:, None], T[:, 0], anchor)
+        T[:, 1] = np.where(keep[:, None], T[:, 1], F0)
+        T[:, 3] = np.where(keep[:, None], T[:, 3], v_old)
+        T[:, 2] = np.where(keep[:, None], T[:, 2], F)
         friction_work += energy
         wear_depth += dw
         wear_volume += np.where(dw > 0.0, dv, 0.0)
@@ -171,24 +182,27 @@ def guided_step(pose, wrench, inverse_mass, acceleration, axis, start, terms, t,
     pose[10:13] = 0.0
 
 
-def balance_offset(body_vertices, pose, axis, planes, area_vectors, law, load):
+def balance_offset(body_vertices, pose, axis, planes, vertex_planes, active, area_vectors, law,
+                   load):
     """Same contract as :func:`meshwear.kernels.balance.balance_offset`, solved
     by another route: sort every breakpoint of the piecewise-linear contact
     force g(z), evaluate g there, and interpolate in the piece that holds the
     load."""
     R = quaternion_matrix(pose[3:7])
-    x = pose[0:3] + body_vertices @ R.T
+    x = pose[0:3] + body_vertices[active] @ R.T
+    av = area_vectors[active]
     zs, ws, signs = [], [], []
-    for p, n, _ in planes:
-        beta = axis @ n
-        if beta == 0.0:
-            continue
-        area = contact_areas(area_vectors, R, n)
+    slots = [np.broadcast_to(pl, (len(active), 3, 3)) for pl in planes]
+    slots += [vp[active] for vp in vertex_planes]
+    for pl in slots:
+        p, n = pl[:, 0], pl[:, 1]
+        beta = n @ axis
+        area = contact_areas(av, R, n)
         c = law[5] + law[6] * area
-        ok = (area > FACING * area_vectors[:, 3]) & (c > 0.0)
-        zs.append(-((x - p) @ n)[ok] / beta)
-        ws.append(c[ok] * beta ** 2)
-        signs.append(np.full(ok.sum(), np.sign(beta)))
+        ok = (beta != 0.0) & (area > FACING * av[:, 3]) & (c > 0.0)
+        zs.append(-_dot(x - p, n)[ok] / beta[ok])
+        ws.append(c[ok] * beta[ok] ** 2)
+        signs.append(np.sign(beta[ok]))
     z_j, w, sign = np.concatenate(zs), np.concatenate(ws), np.concatenate(signs)
     carrying = sign > 0 if load >= 0 else sign < 0
     if not carrying.any():

@@ -48,8 +48,14 @@ def _random_case(rng, n, n_planes, wear_law, along_vertex_normal):
 
 
 def _call(fn, vertices, pose, planes, params, law, direction, a):
-    fn(vertices, pose, planes, params, law, direction, a["contact_state"], a["tangential"],
-       a["normal_force"], a["friction_work"], a["wear_depth"], a["wear_volume"], a["wrench"])
+    """``fn`` on the arrays of ``a``; its ``vertex_planes`` and ``active``
+    default to no mesh surface and every vertex."""
+    n = len(vertices)
+    vertex_planes = a.get("vertex_planes", contact.no_mesh_planes(n))
+    active = a.get("active", contact.all_vertices(n))
+    fn(vertices, pose, planes, vertex_planes, active, params, law, direction,
+       a["contact_state"], a["tangential"], a["normal_force"], a["friction_work"],
+       a["wear_depth"], a["wear_volume"], a["wrench"])
 
 
 def _close(a, b):
@@ -64,10 +70,10 @@ def _close(a, b):
     return bool(np.all(np.abs(a - b) <= RTOL * (np.abs(b) + scale)))
 
 
-@pytest.mark.parametrize("kernel", [contact.plane_contact_serial, contact.plane_contact_parallel])
+@pytest.mark.parametrize("kernel", [contact.contact_serial, contact.contact_parallel])
 @pytest.mark.parametrize("wear_law", [contact.ENERGY, contact.ENERGY_DENSITY, contact.ARCHARD])
 @pytest.mark.parametrize("along_vertex_normal", [False, True])
-def test_plane_contact_matches_numpy_twin(kernel, wear_law, along_vertex_normal):
+def test_contact_matches_numpy_twin(kernel, wear_law, along_vertex_normal):
     rng = np.random.default_rng(7 + wear_law)
     vertices, pose, planes, params, law, direction, arrays = _random_case(
         rng, 400, 2, wear_law, along_vertex_normal)
@@ -79,13 +85,72 @@ def test_plane_contact_matches_numpy_twin(kernel, wear_law, along_vertex_normal)
         pose[0:3] += 2e-4 * np.array([np.sin(k), np.cos(0.7 * k), np.sin(0.3 * k) - 0.2])
         pose[7:10] = 0.05 * np.array([np.cos(0.9 * k), -np.sin(0.5 * k), 0.01])
         _call(kernel, vertices, pose, planes, params, law, direction, arrays)
-        _call(reference.plane_contact, twin_vertices, pose, planes, params, law, direction, twin_arrays)
+        _call(reference.contact, twin_vertices, pose, planes, params, law, direction, twin_arrays)
         seen_states |= set(np.unique(arrays["contact_state"]).tolist())
         for name in arrays:
             assert _close(arrays[name], twin_arrays[name]), (k, name)
         assert _close(vertices, twin_vertices), k
     assert seen_states == {0, 1, 2}, "the case must exercise no contact, stick and slip"
     assert arrays["wear_depth"].max() > 0.0
+
+
+@pytest.mark.parametrize("kernel", [contact.contact_serial, contact.contact_parallel])
+def test_mesh_slots_and_active_set_match_numpy_twin(kernel):
+    """Per-vertex planes (a mesh surface's faces, moving, some vertices with
+    no face in reach) after an analytic plane, on a part of the vertices."""
+    rng = np.random.default_rng(5)
+    n = 300
+    vertices, pose, planes, params, law, direction, arrays = _random_case(
+        rng, n, 3, contact.ARCHARD, False)
+    vertex_planes = np.repeat(planes[1:, None], n, axis=1).copy()
+    tilt = vertex_planes[:, :, 1] + rng.normal(scale=0.05, size=(2, n, 3))
+    vertex_planes[:, :, 1] = tilt / np.linalg.norm(tilt, axis=2)[:, :, None]
+    vertex_planes[:, :, 2] += rng.normal(scale=0.02, size=(2, n, 3))
+    vertex_planes[:, ::7] = 0.0                      # no face within reach
+    arrays.update(vertex_planes=vertex_planes, active=np.flatnonzero(rng.random(n) < 0.6))
+    planes = planes[:1]
+    twin_vertices = vertices.copy()
+    twin_arrays = {k: v.copy() for k, v in arrays.items()}
+    idle = np.setdiff1d(np.arange(n), arrays["active"])
+    seen_states = set()
+    for k in range(40):
+        pose[0:3] += 2e-4 * np.array([np.sin(k), np.cos(0.7 * k), np.sin(0.3 * k) - 0.2])
+        pose[7:10] = 0.05 * np.array([np.cos(0.9 * k), -np.sin(0.5 * k), 0.01])
+        _call(kernel, vertices, pose, planes, params, law, direction, arrays)
+        _call(reference.contact, twin_vertices, pose, planes, params, law, direction, twin_arrays)
+        seen_states |= set(np.unique(arrays["contact_state"][1:]).tolist())
+        for name in arrays:
+            assert _close(arrays[name], twin_arrays[name]), (k, name)
+        assert _close(vertices, twin_vertices), k
+    assert seen_states == {0, 1, 2}
+    # vertices outside the active set are not touched
+    assert not arrays["contact_state"][:, idle].any() and not arrays["wear_depth"][idle].any()
+    assert arrays["wear_depth"].max() > 0.0
+
+
+def test_a_sticking_anchor_moves_with_its_counter_surface():
+    """A point stuck to a plane that moves at u along itself, the point moving
+    with it: the spring does not stretch (the anchor is the surface's point)."""
+    vertices = np.zeros((1, 3))
+    pose = np.zeros(13)
+    pose[3] = 1.0
+    pose[2] = -1e-6
+    planes = np.zeros((1, 3, 3))
+    planes[0, 1, 2] = 1.0
+    planes[0, 2, 0] = 0.2  # the plane moves at 0.2 m/s along x
+    law = contact.make_law(friction=0.5, static_friction=0.5, wear_law="energy",
+                           wear_coefficient=0.0, dt=1e-4, stiffness=1e6, tangential_stiffness=1e6)
+    for kernel in (contact.contact, reference.contact):
+        a = dict(contact_state=np.zeros((1, 1), np.int8), tangential=np.zeros((1, 1, 4, 3)),
+                 normal_force=np.zeros((1, 1)), friction_work=np.zeros(1), wear_depth=np.zeros(1),
+                 wear_volume=np.zeros(1), wrench=np.zeros(6))
+        p = pose.copy()
+        p[7] = 0.2
+        for k in range(50):
+            p[0] = 0.2 * k * 1e-4
+            _call(kernel, vertices, p, planes, FACING_DOWN, law, np.zeros((0, 3)), a)
+            assert a["contact_state"][0, 0] == contact.STICK
+        assert np.abs(a["tangential"][0, 0, contact.FORCE]).max() < 1e-9
 
 
 def test_contact_state_machine_transitions():
@@ -104,30 +169,30 @@ def test_contact_state_machine_transitions():
              normal_force=np.zeros((1, 1)), friction_work=np.zeros(1), wear_depth=np.zeros(1),
              wear_volume=np.zeros(1), wrench=np.zeros(6))
     N = c * 1e-6
-    _call(contact.plane_contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
+    _call(contact.contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
     assert a["contact_state"][0, 0] == contact.STICK
     assert a["normal_force"][0, 0] == pytest.approx(N)
     # drag 0.4 µm: spring force 0.4 N < f0 N = 0.5 N, still stick, force continuous from F0 = 0
     pose[0] = 0.4e-6
     pose[7] = 1e-9
-    _call(contact.plane_contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
+    _call(contact.contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
     assert a["contact_state"][0, 0] == contact.STICK
     assert a["tangential"][0, 0, 2, 0] == pytest.approx(-0.4, rel=1e-6)
     # drag to 0.6 µm: past the static limit, slip with F = -f N along the slip velocity
     pose[0] = 0.6e-6
-    _call(contact.plane_contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
+    _call(contact.contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
     assert a["contact_state"][0, 0] == contact.SLIP
     assert a["tangential"][0, 0, 2, 0] == pytest.approx(-0.5)
     # reverse: stick again, starting from the slip force (F0 = -0.5 N, no jump)
     pose[7] = -1e-9
-    _call(contact.plane_contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
+    _call(contact.contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
     assert a["contact_state"][0, 0] == contact.STICK
     assert a["tangential"][0, 0, 1, 0] == pytest.approx(-0.5)
     # anchored one step back at the turning point: the spring already unloads
     assert a["tangential"][0, 0, 2, 0] == pytest.approx(-0.5 + c * 1e-9 * 1e-3, rel=1e-9)
     # lift off: no contact, no force
     pose[2] = 1e-6
-    _call(contact.plane_contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
+    _call(contact.contact, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
     assert a["contact_state"][0, 0] == contact.NO_CONTACT
     assert a["normal_force"][0, 0] == 0.0 and not a["tangential"][0, 0, 2].any()
 
@@ -212,12 +277,12 @@ def test_reversal_exactly_on_a_step_starts_stick_despite_a_dip_in_load():
     for k in range(10):
         pose[0] = 1e-6 * k
         pose[7] = 1e-3
-        _call(contact.plane_contact, *args, a)
+        _call(contact.contact, *args, a)
     assert a["contact_state"][0, 0] == contact.SLIP
     # turning point: round-off velocity against the motion, and N a hair lower
     pose[2] = -1e-6 * (1 - 1e-12)
     pose[7] = -1e-20
-    _call(contact.plane_contact, *args, a)
+    _call(contact.contact, *args, a)
     assert a["contact_state"][0, 0] == contact.STICK
     twin = {k: v.copy() for k, v in a.items()}
     # and the twin agrees on the same step
@@ -228,11 +293,11 @@ def test_reversal_exactly_on_a_step_starts_stick_despite_a_dip_in_load():
     for k in range(10):
         pose[0] = 1e-6 * k
         pose[7] = 1e-3
-        _call(reference.plane_contact, vertices.copy(), pose, planes, FACING_DOWN, law,
+        _call(reference.contact, vertices.copy(), pose, planes, FACING_DOWN, law,
               np.zeros((0, 3)), a2)
     pose[2] = -1e-6 * (1 - 1e-12)
     pose[7] = -1e-20
-    _call(reference.plane_contact, vertices.copy(), pose, planes, FACING_DOWN, law,
+    _call(reference.contact, vertices.copy(), pose, planes, FACING_DOWN, law,
           np.zeros((0, 3)), a2)
     assert a2["contact_state"][0, 0] == contact.STICK
     assert _close(a2["tangential"], twin["tangential"])
@@ -255,15 +320,23 @@ def test_balance_offset_matches_numpy_twin(load, opposed):
     law[6] = 3e10  # per-area normal stiffness on top of the per-point one
     axis = np.array([0.1, -0.2, 1.0])
     axis /= np.linalg.norm(axis)
-    expected = reference.balance_offset(vertices, pose, axis, planes, params, law, load)
+    # the second plane as a mesh surface would give it: one plane per vertex,
+    # tilted a little differently under each; every third vertex inactive
+    vertex_planes = np.repeat(planes[1:2, None], 300, axis=1).copy()
+    tilt = vertex_planes[0, :, 1] + rng.normal(scale=0.02, size=(300, 3))
+    vertex_planes[0, :, 1] = tilt / np.linalg.norm(tilt, axis=1)[:, None]
+    planes = planes[:1]
+    active = np.flatnonzero(np.arange(300) % 3 != 0)
+    args = (vertices, pose, axis, planes, vertex_planes, active, params, law, load)
+    expected = reference.balance_offset(*args)
     scratch = np.zeros((2, 600))
     if not opposed and load < 0.0:
         # every plane faces the body from below: nothing can pull it down
         assert np.isnan(expected)
-        assert np.isnan(balance_offset(vertices, pose, axis, planes, params, law, load, 0.0, scratch))
+        assert np.isnan(balance_offset(*args, 0.0, scratch))
         return
     for guess in (0.0, -0.05, 0.05, expected):
-        z = balance_offset(vertices, pose, axis, planes, params, law, load, guess, scratch)
+        z = balance_offset(*args, guess, scratch)
         assert z == pytest.approx(expected, rel=1e-12, abs=1e-15)
     # the force at the solution is the load
     moved = pose.copy()
@@ -272,9 +345,10 @@ def test_balance_offset_matches_numpy_twin(load, opposed):
     moved[7:13] = 0.0
     static = law.copy()
     static[[7, 8, 11, 12]] = 0.0   # no damping, and planes at rest: only normal forces
-    resting = planes.copy()
-    resting[:, 2] = 0.0
-    _call(reference.plane_contact, vertices.copy(), moved, resting, params, static, direction, s)
+    resting, resting_vertex = planes.copy(), vertex_planes.copy()
+    resting[:, 2] = resting_vertex[:, :, 2] = 0.0
+    s.update(vertex_planes=resting_vertex, active=active)
+    _call(reference.contact, vertices.copy(), moved, resting, params, static, direction, s)
     assert s["wrench"][0:3] @ axis == pytest.approx(load, rel=1e-9)
 
 
@@ -290,13 +364,16 @@ def test_balance_offset_refuses_a_load_nothing_can_carry():
                            wear_coefficient=0.0, dt=1e-5, stiffness=1e6)
     up = np.array([0.0, 0.0, 1.0])
     scratch = np.zeros((2, 1))
+    none, one = contact.no_mesh_planes(1), contact.all_vertices(1)
     # a plane under the point carries a load pressing down (contact pushes +z) ...
-    assert balance_offset(vertices, pose, up, planes, FACING_DOWN, law, 2.0, 0.0, scratch) == pytest.approx(-2e-6)
+    assert balance_offset(vertices, pose, up, planes, none, one, FACING_DOWN, law, 2.0, 0.0,
+                          scratch) == pytest.approx(-2e-6)
     # ... but nothing can pull it down: a load along -z has no carrier
-    assert np.isnan(balance_offset(vertices, pose, up, planes, FACING_DOWN, law, -2.0, 0.0, scratch))
+    assert np.isnan(balance_offset(vertices, pose, up, planes, none, one, FACING_DOWN, law, -2.0, 0.0,
+                                   scratch))
     # and a free axis lying in the plane has no normal-force component at all
-    assert np.isnan(balance_offset(vertices, pose, np.array([1.0, 0.0, 0.0]), planes, FACING_DOWN,
-                                   law, 2.0, 0.0, scratch))
+    assert np.isnan(balance_offset(vertices, pose, np.array([1.0, 0.0, 0.0]), planes, none, one,
+                                   FACING_DOWN, law, 2.0, 0.0, scratch))
 
 
 def test_a_reversal_step_longer_than_the_unloading_slips_again_at_once():
@@ -318,15 +395,15 @@ def test_a_reversal_step_longer_than_the_unloading_slips_again_at_once():
     args = (vertices, pose, planes, FACING_DOWN, law, np.zeros((0, 3)))
     for k in range(4):                        # 2 µm steps along +x: slips at f N = 0.5 N
         pose[0], pose[7] = 2e-6 * k, 2e-3
-        _call(contact.plane_contact, *args, a)
+        _call(contact.contact, *args, a)
     assert a["contact_state"][0, 0] == contact.SLIP
     work = a["friction_work"][0]
     pose[0], pose[7] = 3e-6, -3e-3             # back 3 µm: unloading takes 2 f N / c = 1 µm
-    _call(contact.plane_contact, *args, a)
+    _call(contact.contact, *args, a)
     assert a["contact_state"][0, 0] == contact.SLIP
     assert a["tangential"][0, 0, 2, 0] == pytest.approx(0.5)
     assert a["friction_work"][0] - work == pytest.approx(0.5 * 3e-6)
     # a turning point with only round-off motion keeps the stick branch
     pose[7] = 1e-20
-    _call(contact.plane_contact, *args, a)
+    _call(contact.contact, *args, a)
     assert a["contact_state"][0, 0] == contact.STICK

@@ -29,21 +29,24 @@ MAX_ITERATIONS = 200
 
 
 @njit(cache=True)
-def _pairs(body_vertices, pose, axis, planes, area, law, breakpoint, weight):
+def _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law, breakpoint, weight):
     """Fill ``breakpoint`` (z_j) and ``weight`` (w_j, signed as beta) of every
     pair that can touch; return how many."""
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
     c0, c1 = law[5], law[6]
+    n_planes = planes.shape[0]
     count = 0
-    for s in range(planes.shape[0]):
-        nx, ny, nz = planes[s, 1, 0], planes[s, 1, 1], planes[s, 1, 2]
-        beta = axis[0] * nx + axis[1] * ny + axis[2] * nz
-        if beta == 0.0:
-            continue
-        mx = r00 * nx + r10 * ny + r20 * nz
-        my = r01 * nx + r11 * ny + r21 * nz
-        mz = r02 * nx + r12 * ny + r22 * nz
-        for i in range(body_vertices.shape[0]):
+    for s in range(n_planes + vertex_planes.shape[0]):
+        for k in range(active.shape[0]):
+            i = active[k]
+            plane = planes[s] if s < n_planes else vertex_planes[s - n_planes, i]
+            nx, ny, nz = plane[1, 0], plane[1, 1], plane[1, 2]
+            beta = axis[0] * nx + axis[1] * ny + axis[2] * nz
+            if beta == 0.0:
+                continue
+            mx = r00 * nx + r10 * ny + r20 * nz
+            my = r01 * nx + r11 * ny + r21 * nz
+            mz = r02 * nx + r12 * ny + r22 * nz
             a = -(mx * area[i, 0] + my * area[i, 1] + mz * area[i, 2])
             if a <= FACING * area[i, 3]:
                 continue
@@ -54,8 +57,7 @@ def _pairs(body_vertices, pose, axis, planes, area, law, breakpoint, weight):
             px = pose[0] + r00 * bx + r01 * by + r02 * bz
             py = pose[1] + r10 * bx + r11 * by + r12 * bz
             pz = pose[2] + r20 * bx + r21 * by + r22 * bz
-            delta = ((px - planes[s, 0, 0]) * nx + (py - planes[s, 0, 1]) * ny
-                     + (pz - planes[s, 0, 2]) * nz)
+            delta = (px - plane[0, 0]) * nx + (py - plane[0, 1]) * ny + (pz - plane[0, 2]) * nz
             breakpoint[count] = -delta / beta
             weight[count] = c * beta * beta * (1.0 if beta > 0.0 else -1.0)
             count += 1
@@ -77,7 +79,8 @@ def _force(z, breakpoint, weight, count):
 
 
 @njit(cache=True)
-def balance_offset(body_vertices, pose, axis, planes, area, law, load, guess, scratch):
+def balance_offset(body_vertices, pose, axis, planes, vertex_planes, active, area, law, load,
+                   guess, scratch):
     """Offset ``z`` (m) along ``axis`` at which the contact normal forces on
     the body at ``pose`` add up to ``load`` (N) along ``axis``.
 
@@ -85,10 +88,13 @@ def balance_offset(body_vertices, pose, axis, planes, area, law, load, guess, sc
     faces the body along the axis, or the load pulls it away from every
     plane). ``guess`` (m) warm-starts the iteration: the previous step's
     offset is usually within one linear piece of the answer. ``scratch`` is a
-    (2, n P) work array, so a step allocates nothing.
+    (2, k S) work array (``k`` active vertices, ``S`` surfaces), so a step
+    allocates nothing. A mesh surface's planes are those of ``vertex_planes``
+    (the faces under the vertices before the move).
     """
     breakpoint, weight = scratch[0], scratch[1]
-    count = _pairs(body_vertices, pose, axis, planes, area, law, breakpoint, weight)
+    count = _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law,
+                   breakpoint, weight)
     # the side that must carry the load: pairs pushing along +axis for a
     # positive load (beta > 0), along -axis for a negative one
     edge = np.nan

@@ -1,8 +1,9 @@
-"""Point-plane contact, friction and wear of one body against analytic planes.
+"""Point-plane contact, friction and wear of one body against its counter-surfaces.
 
-One fused kernel does, for every vertex ``i`` of a worn body and every plane
-``s``, the phases of DESIGN.md §1 in order: penetration, normal force (eq. 1),
-the stick/slip state machine (eq. 2-4), dissipated energy, wear (eq. 5 and its
+One fused kernel does, for every active vertex ``i`` of a worn body and every
+counter-surface ``s`` (the analytic planes first, then the mesh surfaces), the
+phases of DESIGN.md §1 in order: penetration, normal force (eq. 1), the
+stick/slip state machine (eq. 2-4), dissipated energy, wear (eq. 5 and its
 variants) and the geometry update. Fusing keeps each vertex's data in registers
 for one pass; the phases stay readable as the small inline functions below.
 
@@ -15,6 +16,14 @@ pose : (13,)
 planes : (P, 3, 3)
     Per plane: a point on it (m), its unit normal ``n`` pointing into the worn
     body, and its translational velocity (m/s).
+vertex_planes : (M, n, 3, 3)
+    Per mesh counter-surface and vertex, the same for the plane of the
+    counter face under the vertex, the velocity being the counter-surface's at
+    that point (:mod:`meshwear.kernels.nearest` fills it); a zero normal means
+    no face within reach. Pair slot ``P + m``.
+active : (k,) int64
+    Indices of the vertices to process (the active set); the others are out of
+    reach of every surface and keep no contact.
 area : (n, 4)
     Area vector of each vertex in the body frame (m², the third of each
     adjacent face's area times its outward unit normal, summed) and its
@@ -34,13 +43,14 @@ body_vertices : (n, 3)
 wear_direction : (n, 3) or (0, 3)
     Inward unit vertex normals in the body frame when wear moves vertices
     along them; an empty array moves vertices along the contact normal.
-contact_state : (P, n) int8
+contact_state : (P + M, n) int8
     0 no contact, 1 stick, 2 slip; updated in place.
-tangential : (P, n, 4, 3)
-    Per contact pair: stick anchor ``r0`` (m, world, on the plane), friction
+tangential : (P + M, n, 4, 3)
+    Per contact pair: stick anchor ``r0`` (m, world, on the plane; it moves
+    with the counter-surface's velocity while the pair sticks), friction
     force ``F0`` when stick began (N), current friction force ``F`` (N) and the
     last non-zero slip velocity (m/s); updated in place.
-normal_force : (P, n)
+normal_force : (P + M, n)
     ``N`` (N), written.
 friction_work, wear_depth, wear_volume : (n,)
     Cumulative dissipated energy ``E`` (J), wear depth ``w`` (m) and worn
@@ -101,11 +111,12 @@ def rotation_entries(q):
             2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y))
 
 
-def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
-                   contact_state, tangential, normal_force,
-                   friction_work, wear_depth, wear_volume, wrench):
+def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear_direction,
+             contact_state, tangential, normal_force,
+             friction_work, wear_depth, wear_volume, wrench):
     n_points = body_vertices.shape[0]
     n_planes = planes.shape[0]
+    n_slots = n_planes + vertex_planes.shape[0]
     f, f0, wear_law, k, dt = law[0], law[1], int(law[2]), law[3], law[4]
     c0, c1, d0, d1 = law[5], law[6], law[7], law[8]
     ct0, ct1, dt0, dt1 = law[9], law[10], law[11], law[12]
@@ -122,7 +133,8 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
         local[s, 0] = r00 * nx + r10 * ny + r20 * nz
         local[s, 1] = r01 * nx + r11 * ny + r21 * nz
         local[s, 2] = r02 * nx + r12 * ny + r22 * nz
-    for i in prange(n_points):
+    for slot in prange(active.shape[0]):
+        i = active[slot]
         bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
         # world offset from the centre of mass, position and velocity of point A
         rx = r00 * bx + r01 * by + r02 * bz
@@ -132,15 +144,25 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
         ux = vx + wy * rz - wz * ry
         uy = vy + wz * rx - wx * rz
         uz = vz + wx * ry - wy * rx
-        for s in range(n_planes):
-            nx, ny, nz = planes[s, 1, 0], planes[s, 1, 1], planes[s, 1, 2]
+        for s in range(n_slots):
+            if s < n_planes:
+                plane = planes[s]
+                mx, my, mz = local[s, 0], local[s, 1], local[s, 2]
+            else:
+                # a mesh counter-surface: the plane of its face under this
+                # vertex (a zero normal: no face within reach)
+                plane = vertex_planes[s - n_planes, i]
+                hx, hy, hz = plane[1, 0], plane[1, 1], plane[1, 2]
+                mx = r00 * hx + r10 * hy + r20 * hz
+                my = r01 * hx + r11 * hy + r21 * hz
+                mz = r02 * hx + r12 * hy + r22 * hz
+            nx, ny, nz = plane[1, 0], plane[1, 1], plane[1, 2]
             # Delta = (x - p) . n, negative in penetration
-            delta = ((px - planes[s, 0, 0]) * nx + (py - planes[s, 0, 1]) * ny
-                     + (pz - planes[s, 0, 2]) * nz)
+            delta = (px - plane[0, 0]) * nx + (py - plane[0, 1]) * ny + (pz - plane[0, 2]) * nz
             # contact area: the vertex's area vector projected on the plane,
             # -(R a) . n; a vertex whose surface does not face the plane
             # (a side face standing on it) carries nothing
-            a = -(local[s, 0] * area[i, 0] + local[s, 1] * area[i, 1] + local[s, 2] * area[i, 2])
+            a = -(mx * area[i, 0] + my * area[i, 1] + mz * area[i, 2])
             if delta >= 0.0 or a <= FACING * area[i, 3]:
                 contact_state[s, i] = NO_CONTACT
                 normal_force[s, i] = 0.0
@@ -148,7 +170,7 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                     tangential[s, i, FORCE, j] = 0.0
                 continue
             # velocity of A relative to the plane: normal rate and slip velocity
-            gx, gy, gz = ux - planes[s, 2, 0], uy - planes[s, 2, 1], uz - planes[s, 2, 2]
+            gx, gy, gz = ux - plane[2, 0], uy - plane[2, 1], uz - plane[2, 2]
             rate = gx * nx + gy * ny + gz * nz
             sx, sy, sz = gx - rate * nx, gy - rate * ny, gz - rate * nz
             c, d, ct, dtan = c0 + c1 * a, d0 + d1 * a, ct0 + ct1 * a, dt0 + dt1 * a
@@ -164,7 +186,11 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
             # friction state of the pair (tangential[s, i]): stick anchor o,
             # force when stick began h, friction force F, last slip velocity l;
             # read and written only where the state machine needs them
-            if state == NO_CONTACT:
+            if state == STICK:
+                # the anchor is a point of the counter-surface: it moves with it
+                for j in range(3):
+                    tangential[s, i, ANCHOR, j] += plane[2, j] * dt
+            elif state == NO_CONTACT:
                 # a new contact starts in stick with F0 = 0 at its position
                 state = STICK
                 tangential[s, i, ANCHOR, 0] = ax
@@ -262,6 +288,7 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                 wear_depth[i] += dw
                 wear_volume[i] += dv
                 # geometry update: into the body along +n, in the body frame
+                # (mx, my, mz) is the contact normal in the body frame
                 if along_vertex_normal:
                     mx, my, mz = wear_direction[i, 0], wear_direction[i, 1], wear_direction[i, 2]
                     if state == STICK:
@@ -275,8 +302,6 @@ def _plane_contact(body_vertices, pose, planes, area, law, wear_direction,
                         tangential[s, i, ANCHOR, 0] += dw * (hx - hn * nx)
                         tangential[s, i, ANCHOR, 1] += dw * (hy - hn * ny)
                         tangential[s, i, ANCHOR, 2] += dw * (hz - hn * nz)
-                else:
-                    mx, my, mz = local[s, 0], local[s, 1], local[s, 2]
                 body_vertices[i, 0] += dw * mx
                 body_vertices[i, 1] += dw * my
                 body_vertices[i, 2] += dw * mz
@@ -306,22 +331,31 @@ def _named_copy(fn, name):
 # keep their IEEE meaning (no "nnan"/"ninf"), so non-finite states are still
 # caught downstream.
 _FLAGS = {"contract"}
-plane_contact_serial = njit(cache=True, fastmath=_FLAGS)(
-    _named_copy(_plane_contact, "plane_contact_serial"))
-plane_contact_parallel = njit(cache=True, parallel=True, fastmath=_FLAGS)(
-    _named_copy(_plane_contact, "plane_contact_parallel"))
+contact_serial = njit(cache=True, fastmath=_FLAGS)(_named_copy(_contact, "contact_serial"))
+contact_parallel = njit(cache=True, parallel=True, fastmath=_FLAGS)(
+    _named_copy(_contact, "contact_parallel"))
 
 
-def plane_contact(body_vertices, pose, planes, area, law, wear_direction,
-                  contact_state, tangential, normal_force,
-                  friction_work, wear_depth, wear_volume, wrench):
-    """Contact, friction and wear of every vertex against every plane, one step.
+def contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear_direction,
+            contact_state, tangential, normal_force, friction_work, wear_depth, wear_volume,
+            wrench):
+    """Contact, friction and wear of the ``active`` vertices against every
+    plane and mesh counter-surface, one step.
 
     See the module docstring for the arrays. Picks the threaded kernel when the
-    number of vertex-plane pairs makes threads worth starting.
+    number of vertex-surface pairs makes threads worth starting.
     """
-    kernel = (plane_contact_parallel
-              if body_vertices.shape[0] * planes.shape[0] >= PARALLEL_THRESHOLD
-              else plane_contact_serial)
-    kernel(body_vertices, pose, planes, area, law, wear_direction,
+    slots = planes.shape[0] + vertex_planes.shape[0]
+    kernel = contact_parallel if active.shape[0] * slots >= PARALLEL_THRESHOLD else contact_serial
+    kernel(body_vertices, pose, planes, vertex_planes, active, area, law, wear_direction,
            contact_state, tangential, normal_force, friction_work, wear_depth, wear_volume, wrench)
+
+
+def all_vertices(n):
+    """The ``active`` array that processes every one of ``n`` vertices."""
+    return np.arange(n, dtype=np.int64)
+
+
+def no_mesh_planes(n):
+    """The ``vertex_planes`` array of a body that meets no mesh surface."""
+    return np.zeros((0, n, 3, 3))

@@ -3,13 +3,14 @@
 import numpy as np
 
 from ..kernels.contact import FORCE, rotation_entries
+from ..surfaces import contact_areas, slot_normals
 
 
-def body_quantities(body, s, planes):
+def body_quantities(body, s, model):
     """Per-vertex fields and totals of one body, for recorders.
 
-    ``planes`` is the model's (P, 3, 3) plane array: the pressure of a vertex
-    is its normal force over its contact area on each plane, summed.
+    The pressure of a vertex is its normal force over its contact area on
+    each counter-surface, summed.
 
     Returns
     -------
@@ -21,10 +22,11 @@ def body_quantities(body, s, planes):
     normal_force = s.normal_force.sum(axis=0)
     friction_force = s.tangential[:, :, FORCE, :].sum(axis=0)
     pressure = np.zeros(len(s.wear_depth))
-    for j in range(planes.shape[0]):
-        area = -(body.area_vectors[:, 0:3] @ R.T) @ planes[j, 1]
+    for j, normal in enumerate(slot_normals(model, s)):
         loaded = s.normal_force[j] > 0.0
-        pressure[loaded] += s.normal_force[j][loaded] / area[loaded]
+        if loaded.any():
+            area = contact_areas(body, s, normal)
+            pressure[loaded] += s.normal_force[j][loaded] / area[loaded]
     return {
         "points": s.pose[0:3] + s.vertices @ R.T,
         "origin": s.pose[0:3] + R @ body.origin,

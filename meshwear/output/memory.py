@@ -19,7 +19,7 @@ class MemoryHistory:
 
     def on_sample(self, model, state):
         for body, s in zip(model.bodies, state.bodies):
-            q = body_quantities(body, s, model.planes)
+            q = body_quantities(body, s, model)
             r = self._rows.setdefault(body.name, {k: [] for k in (
                 "time", "pose", "origin", "wrench", "friction_work", "wear_volume",
                 "max_wear_depth", "wear_depth", "contact_points")})

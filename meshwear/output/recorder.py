@@ -42,7 +42,7 @@ class RunRecorder:
 
     def on_sample(self, model, state):
         for body, s in zip(model.bodies, state.bodies):
-            q = body_quantities(body, s, model.planes)
+            q = body_quantities(body, s, model)
             states = q["contact_state"]
             row = dict(zip(("x", "y", "z"), q["origin"]))
             row.update(zip(("qw", "qx", "qy", "qz"), s.pose[3:7]))
@@ -57,7 +57,7 @@ class RunRecorder:
 
     def on_frame(self, model, state):
         for body, s in zip(model.bodies, state.bodies):
-            q = body_quantities(body, s, model.planes)
+            q = body_quantities(body, s, model)
             self.series[body.name].write_frame(state.time, q["points"], {k: q[k] for k in FIELDS})
 
     def close(self, summary):
@@ -90,7 +90,7 @@ def summary(model, state, wall_time, status="ok", message=None):
     if message:
         out["message"] = message
     for body, s in zip(model.bodies, state.bodies):
-        q = body_quantities(body, s, model.planes)
+        q = body_quantities(body, s, model)
         out["bodies"][body.name] = {
             "wear_volume": q["wear_volume"],
             "max_wear_depth": q["max_wear_depth"],

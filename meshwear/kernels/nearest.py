@@ -1,0 +1,252 @@
+"""The counter face under each vertex: nearest-face queries on a mesh counter-surface.
+
+A mesh counter-surface gives each vertex of a worn body the plane of its
+nearest face (DESIGN.md §1 is then the same point-plane contact). The faces
+are binned once, in the counter-surface's own frame, into a uniform grid whose
+cells list every face within ``reach`` of any point of the cell
+(:func:`build_grid`); a query looks up the one cell holding the point, so it
+costs a few closest-point tests whatever the mesh size. Built once per
+surface: the surface moves as a rigid body, so its frame carries the grid.
+
+Arrays (C-contiguous float64 unless said otherwise):
+
+rotation : (3, 3)
+    Counter frame -> world rotation at the query time.
+motion : (4, 3)
+    World position of the counter frame's origin (m), translational velocity
+    (m/s), angular velocity (rad/s) and the point the rotation is about (m).
+counter_vertices : (V, 3), faces : (F, 3) int64, face_normals : (F, 3)
+    The counter mesh in its frame, normals pointing out of it (into the worn
+    bodies).
+vertex_normals : (V, 3) or (0, 3)
+    Unit vertex normals to interpolate on the face (smoothed normals), or
+    empty for the face normal.
+grid : (9,)
+    Origin (3), cell size, cells along x, y, z, reach (m), unused.
+keys : (C,) int64, starts : (C + 1,) int64, items : (E,) int64
+    Sorted keys of the non-empty cells, and the faces of cell ``j`` as
+    ``items[starts[j]:starts[j + 1]]``.
+"""
+
+import numpy as np
+from numba import njit, prange
+
+from .contact import _named_copy, rotation_entries  # noqa: F401  (re-exported for twins)
+
+#: relative tolerance under which two faces count as equally near (a point
+#: beyond a shared edge or vertex); the one whose plane separates more wins
+TIE = 1e-9
+
+
+@njit(cache=True, inline="always")
+def closest_on_triangle(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz):
+    """Closest point of triangle abc to p and its barycentric weights
+    (Ericson, Real-Time Collision Detection, 5.1.5): (qx, qy, qz, u, v, w)."""
+    abx, aby, abz = bx - ax, by - ay, bz - az
+    acx, acy, acz = cx - ax, cy - ay, cz - az
+    apx, apy, apz = px - ax, py - ay, pz - az
+    d1 = abx * apx + aby * apy + abz * apz
+    d2 = acx * apx + acy * apy + acz * apz
+    if d1 <= 0.0 and d2 <= 0.0:
+        return ax, ay, az, 1.0, 0.0, 0.0
+    bpx, bpy, bpz = px - bx, py - by, pz - bz
+    d3 = abx * bpx + aby * bpy + abz * bpz
+    d4 = acx * bpx + acy * bpy + acz * bpz
+    if d3 >= 0.0 and d4 <= d3:
+        return bx, by, bz, 0.0, 1.0, 0.0
+    vc = d1 * d4 - d3 * d2
+    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+        v = d1 / (d1 - d3)
+        return ax + v * abx, ay + v * aby, az + v * abz, 1.0 - v, v, 0.0
+    cpx, cpy, cpz = px - cx, py - cy, pz - cz
+    d5 = abx * cpx + aby * cpy + abz * cpz
+    d6 = acx * cpx + acy * cpy + acz * cpz
+    if d6 >= 0.0 and d5 <= d6:
+        return cx, cy, cz, 0.0, 0.0, 1.0
+    vb = d5 * d2 - d1 * d6
+    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+        w = d2 / (d2 - d6)
+        return ax + w * acx, ay + w * acy, az + w * acz, 1.0 - w, 0.0, w
+    va = d3 * d6 - d5 * d4
+    if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
+        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        return bx + w * (cx - bx), by + w * (cy - by), bz + w * (cz - bz), 0.0, 1.0 - w, w
+    denom = 1.0 / (va + vb + vc)
+    v = vb * denom
+    w = vc * denom
+    return (ax + abx * v + acx * w, ay + aby * v + acy * w, az + abz * v + acz * w,
+            1.0 - v - w, v, w)
+
+
+@njit(cache=True, inline="always")
+def _cell_range(yx, yy, yz, grid, keys, starts):
+    """Slice of ``items`` listing the faces near counter-frame point y."""
+    h = grid[3]
+    ix = int(np.floor((yx - grid[0]) / h))
+    iy = int(np.floor((yy - grid[1]) / h))
+    iz = int(np.floor((yz - grid[2]) / h))
+    nx, ny, nz = int(grid[4]), int(grid[5]), int(grid[6])
+    if ix < 0 or iy < 0 or iz < 0 or ix >= nx or iy >= ny or iz >= nz:
+        return 0, 0
+    key = ix + nx * (iy + ny * iz)
+    j = np.searchsorted(keys, key)
+    if j >= keys.shape[0] or keys[j] != key:
+        return 0, 0
+    return starts[j], starts[j + 1]
+
+
+def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
+                    face_normals, vertex_normals, grid, keys, starts, items, out, distance):
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
+    smooth = vertex_normals.shape[0] > 0
+    for k in prange(active.shape[0]):
+        i = active[k]
+        bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
+        # world position, then counter frame: y = Rc^T (x - origin)
+        ex = pose[0] + r00 * bx + r01 * by + r02 * bz - motion[0, 0]
+        ey = pose[1] + r10 * bx + r11 * by + r12 * bz - motion[0, 1]
+        ez = pose[2] + r20 * bx + r21 * by + r22 * bz - motion[0, 2]
+        yx = rotation[0, 0] * ex + rotation[1, 0] * ey + rotation[2, 0] * ez
+        yy = rotation[0, 1] * ex + rotation[1, 1] * ey + rotation[2, 1] * ez
+        yz = rotation[0, 2] * ex + rotation[1, 2] * ey + rotation[2, 2] * ez
+        # the normal it was given last step (world), zero if none: a vertex
+        # keeps to the side it came from, so it cannot be handed the far face
+        # of a thin counter-part (tunnelling) once it is past the middle
+        ox, oy, oz = out[i, 1, 0], out[i, 1, 1], out[i, 1, 2]
+        tracked = ox != 0.0 or oy != 0.0 or oz != 0.0
+        # the previous normal in the counter frame
+        tx = rotation[0, 0] * ox + rotation[1, 0] * oy + rotation[2, 0] * oz
+        ty = rotation[0, 1] * ox + rotation[1, 1] * oy + rotation[2, 1] * oz
+        tz = rotation[0, 2] * ox + rotation[1, 2] * oy + rotation[2, 2] * oz
+        lo, hi = _cell_range(yx, yy, yz, grid, keys, starts)
+        best = -1
+        best_d2 = np.inf
+        best_delta = -np.inf
+        qx = qy = qz = u = v = w = 0.0
+        for j in range(lo, hi):
+            f = items[j]
+            fx, fy, fz = face_normals[f, 0], face_normals[f, 1], face_normals[f, 2]
+            if tracked and fx * tx + fy * ty + fz * tz < 0.0:
+                continue
+            a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+            cx, cy, cz, cu, cv, cw = closest_on_triangle(
+                yx, yy, yz,
+                counter_vertices[a, 0], counter_vertices[a, 1], counter_vertices[a, 2],
+                counter_vertices[b, 0], counter_vertices[b, 1], counter_vertices[b, 2],
+                counter_vertices[c, 0], counter_vertices[c, 1], counter_vertices[c, 2])
+            d2 = (yx - cx) ** 2 + (yy - cy) ** 2 + (yz - cz) ** 2
+            delta = ((yx - counter_vertices[a, 0]) * fx + (yy - counter_vertices[a, 1]) * fy
+                     + (yz - counter_vertices[a, 2]) * fz)
+            tie = TIE * max(d2, best_d2 if best >= 0 else d2)
+            if best < 0 or d2 < best_d2 - tie or (d2 <= best_d2 + tie and delta > best_delta):
+                best, best_d2, best_delta = f, d2, delta
+                qx, qy, qz, u, v, w = cx, cy, cz, cu, cv, cw
+        if best < 0:
+            for row in range(3):
+                for col in range(3):
+                    out[i, row, col] = 0.0
+            distance[i] = np.inf
+            continue
+        distance[i] = np.sqrt(best_d2)
+        if smooth:
+            a, b, c = faces[best, 0], faces[best, 1], faces[best, 2]
+            hx = u * vertex_normals[a, 0] + v * vertex_normals[b, 0] + w * vertex_normals[c, 0]
+            hy = u * vertex_normals[a, 1] + v * vertex_normals[b, 1] + w * vertex_normals[c, 1]
+            hz = u * vertex_normals[a, 2] + v * vertex_normals[b, 2] + w * vertex_normals[c, 2]
+            length = np.sqrt(hx * hx + hy * hy + hz * hz)
+            hx, hy, hz = hx / length, hy / length, hz / length
+        else:
+            hx, hy, hz = face_normals[best, 0], face_normals[best, 1], face_normals[best, 2]
+            # the face's plane: the foot of y on it (its closest point when
+            # that is inside the face)
+            qx, qy, qz = yx - best_delta * hx, yy - best_delta * hy, yz - best_delta * hz
+        # back to the world: point, normal, and the counter-surface's velocity there
+        px = rotation[0, 0] * qx + rotation[0, 1] * qy + rotation[0, 2] * qz + motion[0, 0]
+        py = rotation[1, 0] * qx + rotation[1, 1] * qy + rotation[1, 2] * qz + motion[0, 1]
+        pz = rotation[2, 0] * qx + rotation[2, 1] * qy + rotation[2, 2] * qz + motion[0, 2]
+        out[i, 0, 0], out[i, 0, 1], out[i, 0, 2] = px, py, pz
+        out[i, 1, 0] = rotation[0, 0] * hx + rotation[0, 1] * hy + rotation[0, 2] * hz
+        out[i, 1, 1] = rotation[1, 0] * hx + rotation[1, 1] * hy + rotation[1, 2] * hz
+        out[i, 1, 2] = rotation[2, 0] * hx + rotation[2, 1] * hy + rotation[2, 2] * hz
+        lx, ly, lz = px - motion[3, 0], py - motion[3, 1], pz - motion[3, 2]
+        out[i, 2, 0] = motion[1, 0] + motion[2, 1] * lz - motion[2, 2] * ly
+        out[i, 2, 1] = motion[1, 1] + motion[2, 2] * lx - motion[2, 0] * lz
+        out[i, 2, 2] = motion[1, 2] + motion[2, 0] * ly - motion[2, 1] * lx
+
+
+nearest_planes_serial = njit(cache=True)(_named_copy(_nearest_planes, "nearest_planes_serial"))
+nearest_planes_parallel = njit(cache=True, parallel=True)(
+    _named_copy(_nearest_planes, "nearest_planes_parallel"))
+
+#: active vertices from which the threaded query pays for its threads
+PARALLEL_THRESHOLD = 2048
+
+
+def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
+                   face_normals, vertex_normals, grid, keys, starts, items, out, distance):
+    """For each ``active`` vertex ``i`` of a body at ``pose``, write to
+    ``out[i]`` (3, 3) the plane of its nearest counter face within the grid's
+    reach (point, normal, counter velocity there; world) and to
+    ``distance[i]`` the distance to that face; zeros and ``inf`` where no
+    face qualifies. A vertex that had a plane (``out[i]`` nonzero on entry)
+    only takes faces whose normal is within 90 degrees of the one it had."""
+    kernel = (nearest_planes_parallel if active.shape[0] >= PARALLEL_THRESHOLD
+              else nearest_planes_serial)
+    kernel(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
+           face_normals, vertex_normals, grid, keys, starts, items, out, distance)
+
+
+#: largest number of (cell, face) entries a grid may hold; the cells grow past it
+MAX_ENTRIES = 5_000_000
+
+
+def build_grid(vertices, faces, normals, reach, cell=None):
+    """Bin the faces of a counter mesh: every cell lists each face that has a
+    point within ``reach`` of some point of the cell.
+
+    Parameters
+    ----------
+    vertices, faces, normals : the counter mesh in its frame
+    reach : float
+        m; queries find every face within it.
+    cell : float, optional
+        Cell size (m); default twice the reach or the median edge length,
+        whichever is larger, grown until the grid fits :data:`MAX_ENTRIES`.
+
+    Returns
+    -------
+    grid, keys, starts, items : the arrays :func:`nearest_planes` takes.
+    """
+    tri = vertices[faces]
+    edges = np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2)
+    h = float(cell) if cell else max(2.0 * reach, float(np.median(edges)))
+    lo = vertices.min(axis=0) - reach - 1e-9
+    span = vertices.max(axis=0) + reach + 1e-9 - lo
+    while True:
+        dims = np.maximum(1, np.ceil(span / h)).astype(np.int64)
+        first = np.floor((tri.min(axis=1) - reach - lo) / h).astype(np.int64)
+        last = np.floor((tri.max(axis=1) + reach - lo) / h).astype(np.int64)
+        first, last = np.clip(first, 0, dims - 1), np.clip(last, 0, dims - 1)
+        counts = np.prod(last - first + 1, axis=1)
+        if counts.sum() <= MAX_ENTRIES:
+            break
+        h *= 1.5
+    # every cell of each face's box, kept where the face's plane passes within
+    # reach of the cell (a long slanted CAD triangle spans a thin slab of its box)
+    face_of = np.repeat(np.arange(len(faces)), counts)
+    offset = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    size = (last - first + 1)[face_of]
+    ix = first[face_of, 0] + offset % size[:, 0]
+    iy = first[face_of, 1] + (offset // size[:, 0]) % size[:, 1]
+    iz = first[face_of, 2] + offset // (size[:, 0] * size[:, 1])
+    centre = lo + (np.stack([ix, iy, iz], axis=1) + 0.5) * h
+    plane_gap = np.abs(np.einsum("ij,ij->i", centre - tri[face_of, 0], normals[face_of]))
+    keep = plane_gap <= reach + 0.5 * np.sqrt(3.0) * h
+    key = (ix + dims[0] * (iy + dims[1] * iz))[keep]
+    face_of = face_of[keep]
+    order = np.lexsort((face_of, key))
+    key, face_of = key[order], face_of[order]
+    keys, first_index = np.unique(key, return_index=True)
+    starts = np.append(first_index, len(key)).astype(np.int64)
+    grid = np.array([lo[0], lo[1], lo[2], h, dims[0], dims[1], dims[2], reach, 0.0])
+    return grid, keys.astype(np.int64), starts, face_of.astype(np.int64)
