@@ -199,6 +199,7 @@ def build_model(scene):
     for j, p in enumerate(planes):
         plane_array[j, 0] = p.point
         plane_array[j, 1] = p.normal
+    surface_set = surfaces.SurfaceSet(plane_array, meshes)
 
     run = scene.run
     n_steps = max(1, int(np.ceil(run.duration / run.dt - 1e-9)))
@@ -213,7 +214,7 @@ def build_model(scene):
     bodies = []
     for j, b in enumerate(scene.bodies):
         try:
-            bodies.append(_build_body(scene, j, b))
+            bodies.append(_build_body(scene, j, b, surface_set))
         except geometry.MeshError as err:
             # the mesh loader names the mesh file; add the scene file and the key
             key = f"body[{j}].mesh" if b.mesh is not None else f"body[{j}].shape"
@@ -231,7 +232,6 @@ def build_model(scene):
     quasi_static = run.mode == "quasi-static"
     if quasi_static:  # no inertia, so no damping either
         law[[LAW_SLOTS.index(name) for name in LAW_SLOTS if "damping" in name]] = 0.0
-    surface_set = surfaces.SurfaceSet(plane_array, meshes)
     for j, (b, config) in enumerate(zip(bodies, scene.bodies)):
         vertex_planes = surfaces.initial_planes(surface_set, b, b.initial_pose, 2.0 * b.radius)[0]
         if isinstance(b.motion, BalancedMotion):
@@ -282,7 +282,7 @@ def _even_steps(n_steps, count):
     return np.unique(np.rint(np.linspace(0, n_steps, count)).astype(np.int64))
 
 
-def _build_body(scene, index, body):
+def _build_body(scene, index, body, surface_set):
     key = f"body[{index}]"
     if body.mesh is not None:
         vertices, faces = geometry.load_mesh(body.mesh, body.units)
@@ -292,7 +292,9 @@ def _build_body(scene, index, body):
                                              subdivisions=s.subdivisions, height=s.height,
                                              sections=s.sections)
     if body.resolution is not None:
-        vertices, faces = geometry.refine(vertices, faces, body.resolution)
+        vertices, faces = geometry.refine(vertices, faces, body.resolution,
+                                          face_mask=_faces_to_refine(scene, body, vertices, faces,
+                                                                     surface_set))
     needs_inertia = body.motion in ("free", "guided")
     area = geometry.tributary_areas(vertices, faces)
     try:
@@ -346,6 +348,24 @@ def _build_body(scene, index, body):
         reference_face_normals=geometry.face_normals(body_vertices, faces),
         mass=float(mass), inertia=inertia, origin=-com, initial_pose=pose, motion=motion,
         period=path.period, radius=float(np.linalg.norm(body_vertices, axis=1).max()))
+
+
+#: a face of a body that is not free can come into contact where it faces a
+#: surface within this fraction of the body's bounding-box diagonal
+REFINE_REACH = 0.1
+
+
+def _faces_to_refine(scene, body, vertices, faces, surface_set):
+    """Faces ``resolution`` refines: all of a free body (it may land on any
+    face); of a guided, prescribed or fixed one (which only translates) the
+    faces that face a surface within :data:`REFINE_REACH` of its size at the
+    start (its path's displacement included)."""
+    if body.motion == "free":
+        return None
+    R = np.array(rotation_entries(np.asarray(body.orientation, float))).reshape(3, 3)
+    points = vertices @ R.T + np.asarray(body.position, float) + Path(body.path).displacement(0.0)
+    reach = REFINE_REACH * float(np.linalg.norm(np.ptp(vertices, axis=0)))
+    return surfaces.contact_faces(points, faces, surface_set, reach)
 
 
 #: an initial penetration deeper than this fraction of the body's smallest

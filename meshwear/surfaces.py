@@ -93,7 +93,8 @@ class MeshSurface:
                                            axis=1).max())
         self.reach = 0.0
         self.grid = None
-        self.bvh = fcl.CollisionObject(_bvh(self.vertices, self.faces), fcl.Transform())
+        self.geometry = _bvh(self.vertices, self.faces)
+        self.bvh = fcl.CollisionObject(self.geometry, fcl.Transform())
         self.rotation = np.eye(3)
         self.motion = np.zeros((4, 3))
 
@@ -203,22 +204,22 @@ class SurfaceSet:
             return []
         key = id(body)
         if key not in self.body_bvh:
-            self.body_bvh[key] = fcl.CollisionObject(
-                _bvh(body.reference_vertices, body.faces), fcl.Transform())
-        obj = self.body_bvh[key]
+            geometry_ = _bvh(body.reference_vertices, body.faces)
+            self.body_bvh[key] = (geometry_, fcl.CollisionObject(geometry_, fcl.Transform()))
+        obj = self.body_bvh[key][1]
         obj.setTransform(fcl.Transform(_quaternion_matrix(pose[3:7]), pose[0:3].copy()))
         manager = self._manager(t)
-        found = []
-        index = {id(m.bvh): j for j, m in enumerate(self.meshes)}
+        # the manager hands the callback fresh wrappers of its objects; the
+        # geometries of a distance result are ours, so they name the surface
+        index = {id(m.geometry): j for j, m in enumerate(self.meshes)}
+        found = set()
 
         def near(o1, o2, data):
-            other = o2 if o1 is obj else o1
-            j = index.get(id(other))
-            if j is not None and j not in found:
-                d = fcl.distance(obj, other, fcl.DistanceRequest(), fcl.DistanceResult())
-                if d <= margin:
-                    found.append(j)
-            return False, margin   # keep looking at every pair the margin allows
+            result = fcl.DistanceResult()
+            d = fcl.distance(o1, o2, fcl.DistanceRequest(), result)
+            if d <= margin:
+                found.update(index[id(g)] for g in (result.o1, result.o2) if id(g) in index)
+            return False, margin   # go on with every pair whose boxes are within the margin
 
         manager.distance(obj, None, near)
         return sorted(found)
@@ -335,19 +336,46 @@ def initial_planes(surface_set, body, pose, reach):
     at ``pose`` and t = 0, finding faces up to ``reach`` (m) away: (M, n, 3, 3)
     planes and (M, n) distances. For the placing checks and the first load
     balance, before any active set exists."""
-    from .kernels.contact import all_vertices
-    from .kernels.nearest import nearest_planes as query
+    return _planes_at(body.reference_vertices, pose, surface_set.meshes, reach)
 
-    n = len(body.reference_vertices)
-    out = np.zeros((len(surface_set.meshes), n, 3, 3))
-    distance = np.full((len(surface_set.meshes), n), np.inf)
-    for j, mesh in enumerate(surface_set.meshes):
+
+def _planes_at(body_vertices, pose, meshes, reach):
+    from .kernels.contact import all_vertices
+
+    n = len(body_vertices)
+    out = np.zeros((len(meshes), n, 3, 3))
+    distance = np.full((len(meshes), n), np.inf)
+    for j, mesh in enumerate(meshes):
         grid, keys, starts, items = build_grid(mesh.vertices, mesh.faces, mesh.face_normals, reach)
         rotation, motion = mesh.frame(0.0)
-        query(body.reference_vertices, pose, all_vertices(n), rotation, motion, mesh.vertices,
-              mesh.faces, mesh.face_normals, mesh.vertex_normals, grid, keys, starts, items,
-              out[j], distance[j])
+        nearest_planes(body_vertices, pose, all_vertices(n), rotation, motion, mesh.vertices,
+                       mesh.faces, mesh.face_normals, mesh.vertex_normals, grid, keys, starts,
+                       items, out[j], distance[j])
     return out, distance
+
+
+def contact_faces(points, faces, surface_set, reach):
+    """(m,) bool: the faces of a body (``points`` its vertices in the world at
+    the start) that can come into contact: they face a plane or the nearest
+    face of a mesh surface, and a vertex of theirs lies within ``reach`` (m)
+    of it. For refining a CAD part where it can touch, not everywhere."""
+    from .kernels.contact import FACING
+
+    normals = geometry.face_normals(points, faces)
+    mask = np.zeros(len(faces), dtype=bool)
+    for p in surface_set.planes:
+        near = (points - p[0]) @ p[1] <= reach
+        mask |= (normals @ p[1] < -FACING) & near[faces].any(axis=1)
+    identity = np.zeros(13)
+    identity[3] = 1.0
+    planes, distance = _planes_at(np.ascontiguousarray(points), identity, surface_set.meshes, reach)
+    for vp, d in zip(planes, distance):
+        # a face faces the mesh where one of its vertices near it does
+        for corner in range(3):
+            v = faces[:, corner]
+            facing = np.einsum("ij,ij->i", normals, vp[v, 1]) < -FACING
+            mask |= facing & (d[v] <= reach)
+    return mask
 
 
 def slot_normals(model, s):

@@ -227,3 +227,82 @@ def balance_offset(body_vertices, pose, axis, planes, vertex_planes, active, are
     k = np.searchsorted(-values, -load)            # values[k-1] > load >= values[k]
     z0, z1, g0, g1 = points[k - 1], points[k], values[k - 1], values[k]
     return z0 + (g0 - load) / (g0 - g1) * (z1 - z0)
+
+
+def closest_points(tri, points):
+    """Closest point of each triangle (m, 3, 3) to each point (m, 3), and its
+    barycentric weights: the projection on the plane when it falls inside,
+    else the nearest of the three edges' closest points (another route than
+    the kernel's Voronoi regions)."""
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    n = np.cross(b - a, c - a)
+    n2 = _dot(n, n)
+    proj = points - (_dot(points - a, n) / n2)[:, None] * n
+    # barycentric weights of the projection from sub-triangle areas
+    u = _dot(np.cross(c - b, proj - b), n) / n2
+    v = _dot(np.cross(a - c, proj - c), n) / n2
+    w = 1.0 - u - v
+    inside = (u > 0) & (v > 0) & (w > 0)
+    best = np.where(inside[:, None], proj, np.nan)
+    bary = np.where(inside[:, None], np.stack([u, v, w], axis=1), np.nan)
+    best_d2 = np.where(inside, _dot(proj - points, proj - points), np.inf)
+    for (p, q, i, j) in ((a, b, 0, 1), (b, c, 1, 2), (c, a, 2, 0)):
+        e = q - p
+        t = np.clip(_dot(points - p, e) / _dot(e, e), 0.0, 1.0)
+        cand = p + t[:, None] * e
+        d2 = _dot(cand - points, cand - points)
+        better = ~inside & (d2 < best_d2)
+        weights = np.zeros((len(points), 3))
+        weights[:, i], weights[:, j] = 1.0 - t, t
+        best = np.where(better[:, None], cand, best)
+        bary = np.where(better[:, None], weights, bary)
+        best_d2 = np.where(better, d2, best_d2)
+    return best, bary
+
+
+def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
+                   face_normals, vertex_normals, reach, out, distance, tracking=0.5, tie=1e-9):
+    """Same contract as :func:`meshwear.kernels.nearest.nearest_planes`, by
+    brute force over every face (no grid)."""
+    R = quaternion_matrix(pose[3:7])
+    x = pose[0:3] + body_vertices[active] @ R.T
+    y = (x - motion[0]) @ rotation
+    previous = out[active, 1].copy()
+    tri = counter_vertices[faces]
+    F = len(faces)
+    for row, i in enumerate(active):
+        points = np.repeat(y[row][None], F, axis=0)
+        closest, bary = closest_points(tri, points)
+        d2 = ((points - closest) ** 2).sum(axis=1)
+        delta = _dot(points - tri[:, 0], face_normals)
+        prev = rotation.T @ previous[row]
+        tracked = bool(np.any(previous[row] != 0.0))
+        within = d2 <= reach * reach
+
+        def pick(ok):
+            if not ok.any():
+                return -1
+            best = np.flatnonzero(ok)[np.argmin(d2[ok])]
+            near = ok & (d2 <= d2[best] * (1 + tie))
+            return np.flatnonzero(near)[np.argmax(delta[near])]
+
+        over = d2 - delta ** 2 <= 1e-12 * d2
+        kept = pick(within & over & (face_normals @ prev >= tracking)) \
+            if tracked else -1
+        best = kept if kept >= 0 else pick(within)
+        if best < 0:
+            out[i] = 0.0
+            distance[i] = np.inf
+            continue
+        distance[i] = np.sqrt(d2[best])
+        if vertex_normals.shape[0]:
+            normal = bary[best] @ vertex_normals[faces[best]]
+            normal /= np.linalg.norm(normal)
+            point = closest[best]
+        else:
+            normal = face_normals[best]
+            point = y[row] - delta[best] * normal
+        p = rotation @ point + motion[0]
+        out[i, 0] = p
+        out[i, 1] = rotation @ normal
+        out[i, 2] = motion[1] + np.cross(motion[2], p - motion[3])

@@ -37,6 +37,21 @@ from .contact import _named_copy, rotation_entries  # noqa: F401  (re-exported f
 #: beyond a shared edge or vertex); the one whose plane separates more wins
 TIE = 1e-9
 
+#: a vertex that had a plane last step stays on the faces whose normal is
+#: within 60 degrees of it (cos 60° = 0.5) while it is over one of them: a
+#: vertex pressed into the top face of a counter-part close to its edge stays
+#: on the top face instead of being pushed out sideways through the nearer
+#: side face, and one that has gone past the middle of a thin plate is not
+#: handed the far face (tunnelling). Faceted curved surfaces turn by far less
+#: than 60° between neighbours. Beyond the edge of those faces it takes the
+#: nearest face, as an untracked vertex does.
+TRACKING = 0.5
+
+#: a vertex is over a face (its foot on the face's plane lies in the closed
+#: triangle) when its distance to the face exceeds its distance to the plane
+#: by less than this relative amount (an edge between two faces belongs to both)
+OVER = 1e-12
+
 
 @njit(cache=True, inline="always")
 def closest_on_triangle(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz):
@@ -99,6 +114,7 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
                     face_normals, vertex_normals, grid, keys, starts, items, out, distance):
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
     smooth = vertex_normals.shape[0] > 0
+    reach2 = grid[7] * grid[7]
     for k in prange(active.shape[0]):
         i = active[k]
         bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
@@ -110,8 +126,7 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
         yy = rotation[0, 1] * ex + rotation[1, 1] * ey + rotation[2, 1] * ez
         yz = rotation[0, 2] * ex + rotation[1, 2] * ey + rotation[2, 2] * ez
         # the normal it was given last step (world), zero if none: a vertex
-        # keeps to the side it came from, so it cannot be handed the far face
-        # of a thin counter-part (tunnelling) once it is past the middle
+        # keeps to the faces it came from (TRACKING)
         ox, oy, oz = out[i, 1, 0], out[i, 1, 1], out[i, 1, 2]
         tracked = ox != 0.0 or oy != 0.0 or oz != 0.0
         # the previous normal in the counter frame
@@ -119,15 +134,17 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
         ty = rotation[0, 1] * ox + rotation[1, 1] * oy + rotation[2, 1] * oz
         tz = rotation[0, 2] * ox + rotation[1, 2] * oy + rotation[2, 2] * oz
         lo, hi = _cell_range(yx, yy, yz, grid, keys, starts)
-        best = -1
-        best_d2 = np.inf
-        best_delta = -np.inf
+        # the nearest face, and the nearest of the faces the vertex can stay
+        # on (within TRACKING of its last normal, and with the vertex over
+        # it, not beyond its edges: past a convex edge the vertex lets go)
+        best = kept = -1
+        best_d2 = kept_d2 = np.inf
+        best_delta = kept_delta = -np.inf
         qx = qy = qz = u = v = w = 0.0
+        kx = ky = kz = ku = kv = kw = 0.0
         for j in range(lo, hi):
             f = items[j]
             fx, fy, fz = face_normals[f, 0], face_normals[f, 1], face_normals[f, 2]
-            if tracked and fx * tx + fy * ty + fz * tz < 0.0:
-                continue
             a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
             cx, cy, cz, cu, cv, cw = closest_on_triangle(
                 yx, yy, yz,
@@ -135,12 +152,23 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
                 counter_vertices[b, 0], counter_vertices[b, 1], counter_vertices[b, 2],
                 counter_vertices[c, 0], counter_vertices[c, 1], counter_vertices[c, 2])
             d2 = (yx - cx) ** 2 + (yy - cy) ** 2 + (yz - cz) ** 2
+            if d2 > reach2:
+                continue
             delta = ((yx - counter_vertices[a, 0]) * fx + (yy - counter_vertices[a, 1]) * fy
                      + (yz - counter_vertices[a, 2]) * fz)
             tie = TIE * max(d2, best_d2 if best >= 0 else d2)
             if best < 0 or d2 < best_d2 - tie or (d2 <= best_d2 + tie and delta > best_delta):
                 best, best_d2, best_delta = f, d2, delta
                 qx, qy, qz, u, v, w = cx, cy, cz, cu, cv, cw
+            if (tracked and d2 - delta * delta <= OVER * d2
+                    and fx * tx + fy * ty + fz * tz >= TRACKING):
+                tie = TIE * max(d2, kept_d2 if kept >= 0 else d2)
+                if kept < 0 or d2 < kept_d2 - tie or (d2 <= kept_d2 + tie and delta > kept_delta):
+                    kept, kept_d2, kept_delta = f, d2, delta
+                    kx, ky, kz, ku, kv, kw = cx, cy, cz, cu, cv, cw
+        if kept >= 0:
+            best, best_d2, best_delta = kept, kept_d2, kept_delta
+            qx, qy, qz, u, v, w = kx, ky, kz, ku, kv, kw
         if best < 0:
             for row in range(3):
                 for col in range(3):
@@ -186,10 +214,11 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
                    face_normals, vertex_normals, grid, keys, starts, items, out, distance):
     """For each ``active`` vertex ``i`` of a body at ``pose``, write to
     ``out[i]`` (3, 3) the plane of its nearest counter face within the grid's
-    reach (point, normal, counter velocity there; world) and to
+    reach (``grid[7]``) (point, normal, counter velocity there; world) and to
     ``distance[i]`` the distance to that face; zeros and ``inf`` where no
     face qualifies. A vertex that had a plane (``out[i]`` nonzero on entry)
-    only takes faces whose normal is within 90 degrees of the one it had."""
+    keeps to faces whose normal is within 60 degrees of the one it had while
+    it is over one of them (:data:`TRACKING`)."""
     kernel = (nearest_planes_parallel if active.shape[0] >= PARALLEL_THRESHOLD
               else nearest_planes_serial)
     kernel(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
