@@ -27,7 +27,7 @@ import numpy as np
 
 from . import geometry
 from .kernels.contact import FORCE, NO_CONTACT, rotation_entries
-from .kernels.nearest import build_grid, nearest_planes
+from .kernels.nearest import build_grid, corner_normals, nearest_planes
 from .motion import Path
 
 #: default active-set margin, as a fraction of a body's bounding-box diagonal
@@ -77,8 +77,8 @@ class MeshSurface:
         self.name = name
         self.vertices, self.faces = geometry._arrays(vertices, faces)
         self.face_normals = np.ascontiguousarray(geometry.face_normals(self.vertices, self.faces))
-        self.vertex_normals = (np.ascontiguousarray(geometry.vertex_normals(self.vertices, self.faces))
-                               if smooth_normals else np.zeros((0, 3)))
+        self.corner_normals = (corner_normals(self.vertices, self.faces, self.face_normals)
+                               if smooth_normals else np.zeros((0, 3, 3)))
         self.position = np.asarray(position, float)
         self.R0 = _quaternion_matrix(orientation)
         if rotation is not None:
@@ -144,7 +144,7 @@ class MeshSurface:
         rotation, motion = self.frame(t)
         grid, keys, starts, items = self.grid
         nearest_planes(vertices, pose, active, rotation, motion, self.vertices, self.faces,
-                       self.face_normals, self.vertex_normals, grid, keys, starts, items,
+                       self.face_normals, self.corner_normals, grid, keys, starts, items,
                        out, distance)
 
     def transform(self, t):
@@ -349,7 +349,7 @@ def _planes_at(body_vertices, pose, meshes, reach):
         grid, keys, starts, items = build_grid(mesh.vertices, mesh.faces, mesh.face_normals, reach)
         rotation, motion = mesh.frame(0.0)
         nearest_planes(body_vertices, pose, all_vertices(n), rotation, motion, mesh.vertices,
-                       mesh.faces, mesh.face_normals, mesh.vertex_normals, grid, keys, starts,
+                       mesh.faces, mesh.face_normals, mesh.corner_normals, grid, keys, starts,
                        items, out[j], distance[j])
     return out, distance
 

@@ -261,7 +261,7 @@ def closest_points(tri, points):
 
 
 def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-                   face_normals, vertex_normals, reach, out, distance, tracking=0.5, tie=1e-9):
+                   face_normals, corner_normals, reach, out, distance, tracking=0.5, tie=1e-9):
     """Same contract as :func:`meshwear.kernels.nearest.nearest_planes`, by
     brute force over every face (no grid)."""
     R = quaternion_matrix(pose[3:7])
@@ -295,8 +295,8 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
             distance[i] = np.inf
             continue
         distance[i] = np.sqrt(d2[best])
-        if vertex_normals.shape[0]:
-            normal = bary[best] @ vertex_normals[faces[best]]
+        if corner_normals.shape[0]:
+            normal = bary[best] @ corner_normals[best]
             normal /= np.linalg.norm(normal)
             point = closest[best]
         else:

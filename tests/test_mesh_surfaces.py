@@ -46,8 +46,7 @@ def test_nearest_planes_match_brute_force_twin(smooth):
     rng = np.random.default_rng(3)
     V, F = _bumpy_mesh(rng)
     normals = trimesh.Trimesh(V, F, process=False).face_normals.copy()
-    vnormals = (trimesh.Trimesh(V, F, process=False).vertex_normals.copy() if smooth
-                else np.zeros((0, 3)))
+    vnormals = (nearest.corner_normals(V, F, normals) if smooth else np.zeros((0, 3, 3)))
     reach = 2e-3
     grid = nearest.build_grid(V, F, normals, reach)
     rotation = _rotation(rng)
@@ -424,3 +423,18 @@ smooth_normals = true
     towards_axis = -points[:, 0:2] / np.linalg.norm(points[:, 0:2], axis=1)[:, None]
     assert np.all(np.einsum("ij,ij->i", normals[:, 0:2], towards_axis) > 1 - 1e-6)
     assert loaded.sum() > 30
+
+
+def test_smoothed_normals_blend_across_facets_but_not_across_creases():
+    """A 64-sided cylinder: wall corners get the radial direction (their two
+    facets blended; the caps at 90° left out), cap corners stay axial."""
+    m = trimesh.creation.cylinder(radius=0.01, height=0.02, sections=64)
+    V, F = np.asarray(m.vertices), np.asarray(m.faces, dtype=np.int64)
+    normals = np.asarray(m.face_normals)
+    corners = nearest.corner_normals(V, F, normals)
+    wall = np.abs(normals[:, 2]) < 1e-9
+    p = V[F[wall]]
+    radial = p[..., 0:2] / np.linalg.norm(p[..., 0:2], axis=2)[..., None]
+    assert np.abs(corners[wall][..., 2]).max() < 1e-12
+    assert np.abs(corners[wall][..., 0:2] - radial).max() < 1e-9
+    assert np.abs(np.abs(corners[~wall][..., 2]) - 1.0).max() < 1e-12

@@ -18,9 +18,9 @@ motion : (4, 3)
 counter_vertices : (V, 3), faces : (F, 3) int64, face_normals : (F, 3)
     The counter mesh in its frame, normals pointing out of it (into the worn
     bodies).
-vertex_normals : (V, 3) or (0, 3)
-    Unit vertex normals to interpolate on the face (smoothed normals), or
-    empty for the face normal.
+corner_normals : (F, 3, 3) or (0, 3, 3)
+    Unit normals at each face's corners to interpolate over the face
+    (smoothed normals, :func:`corner_normals`), or empty for the face normal.
 grid : (9,)
     Origin (3), cell size, cells along x, y, z, reach (m), unused.
 keys : (C,) int64, starts : (C + 1,) int64, items : (E,) int64
@@ -111,9 +111,9 @@ def _cell_range(yx, yy, yz, grid, keys, starts):
 
 
 def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-                    face_normals, vertex_normals, grid, keys, starts, items, out, distance):
+                    face_normals, corner_normals, grid, keys, starts, items, out, distance):
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
-    smooth = vertex_normals.shape[0] > 0
+    smooth = corner_normals.shape[0] > 0
     reach2 = grid[7] * grid[7]
     for k in prange(active.shape[0]):
         i = active[k]
@@ -177,10 +177,10 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             continue
         distance[i] = np.sqrt(best_d2)
         if smooth:
-            a, b, c = faces[best, 0], faces[best, 1], faces[best, 2]
-            hx = u * vertex_normals[a, 0] + v * vertex_normals[b, 0] + w * vertex_normals[c, 0]
-            hy = u * vertex_normals[a, 1] + v * vertex_normals[b, 1] + w * vertex_normals[c, 1]
-            hz = u * vertex_normals[a, 2] + v * vertex_normals[b, 2] + w * vertex_normals[c, 2]
+            cn = corner_normals[best]
+            hx = u * cn[0, 0] + v * cn[1, 0] + w * cn[2, 0]
+            hy = u * cn[0, 1] + v * cn[1, 1] + w * cn[2, 1]
+            hz = u * cn[0, 2] + v * cn[1, 2] + w * cn[2, 2]
             length = np.sqrt(hx * hx + hy * hy + hz * hz)
             hx, hy, hz = hx / length, hy / length, hz / length
         else:
@@ -211,7 +211,7 @@ PARALLEL_THRESHOLD = 2048
 
 
 def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-                   face_normals, vertex_normals, grid, keys, starts, items, out, distance):
+                   face_normals, corner_normals, grid, keys, starts, items, out, distance):
     """For each ``active`` vertex ``i`` of a body at ``pose``, write to
     ``out[i]`` (3, 3) the plane of its nearest counter face within the grid's
     reach (``grid[7]``) (point, normal, counter velocity there; world) and to
@@ -222,7 +222,41 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
     kernel = (nearest_planes_parallel if active.shape[0] >= PARALLEL_THRESHOLD
               else nearest_planes_serial)
     kernel(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-           face_normals, vertex_normals, grid, keys, starts, items, out, distance)
+           face_normals, corner_normals, grid, keys, starts, items, out, distance)
+
+
+#: faces meeting at a vertex at more than 60 degrees are a crease: smoothed
+#: normals do not blend across it (a bore's wall and its end face)
+CREASE = 0.5
+
+
+def corner_normals(vertices, faces, normals):
+    """(F, 3, 3) smoothed unit normal at each corner of each face: the mean
+    normal of the faces around that vertex whose normal is within 60 degrees
+    of the face's own (:data:`CREASE`), each weighted by its angle at the
+    vertex (so a facet split into two triangles counts once)."""
+    tri = vertices[faces]
+    e1 = np.roll(tri, -1, axis=1) - tri
+    e2 = np.roll(tri, 1, axis=1) - tri
+    cos = np.einsum("fkj,fkj->fk", e1, e2) / (np.linalg.norm(e1, axis=2) * np.linalg.norm(e2, axis=2))
+    angle = np.arccos(np.clip(cos, -1.0, 1.0)).ravel()   # per corner
+    corner_vertex = faces.ravel()
+    corner_face = np.repeat(np.arange(len(faces)), 3)
+    order = np.argsort(corner_vertex, kind="stable")
+    first = np.searchsorted(corner_vertex[order], np.arange(len(vertices)))
+    last = np.searchsorted(corner_vertex[order], np.arange(len(vertices)), side="right")
+    out = np.zeros((len(faces) * 3, 3))
+    # every (corner, face around its vertex) pair
+    degree = (last - first)[corner_vertex]
+    pair_corner = np.repeat(np.arange(len(corner_vertex)), degree)
+    offset = np.arange(degree.sum()) - np.repeat(np.cumsum(degree) - degree, degree)
+    other_corner = order[first[corner_vertex][pair_corner] + offset]
+    other = corner_face[other_corner]
+    own = normals[corner_face[pair_corner]]
+    keep = np.einsum("ij,ij->i", own, normals[other]) >= CREASE
+    np.add.at(out, pair_corner[keep], (angle[other_corner][:, None] * normals[other])[keep])
+    out /= np.linalg.norm(out, axis=1)[:, None]
+    return np.ascontiguousarray(out.reshape(len(faces), 3, 3))
 
 
 #: largest number of (cell, face) entries a grid may hold; the cells grow past it
