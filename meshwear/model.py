@@ -244,7 +244,7 @@ def build_model(scene):
                                  "surface, or no surface faces it along that axis)")
         else:
             _refuse_deep_start(scene, j, b, config, planes, meshes, vertex_planes)
-    periods = [b.period for b in bodies if b.period is not None]
+    periods = _periods(scene)
     period = scene.wear.period or (max(periods) if periods else None)
     # a plane without a size is drawn 4 body extents wide
     extent = max(float(np.ptp(b.reference_vertices, axis=0).max()) for b in bodies)
@@ -257,6 +257,15 @@ def build_model(scene):
                  cycle_steps=cycle_steps)
 
 
+def _periods(scene):
+    """Cycle lengths (s) of the bodies' and mesh surfaces' periodic motions."""
+    out = [Path(x.path).period for x in scene.bodies + scene.surfaces
+           if getattr(x, "path", None) is not None]
+    out += [2.0 * np.pi / abs(s.rotation.rate) for s in scene.surfaces
+            if getattr(s, "rotation", None) is not None and s.rotation.rate != 0.0]
+    return [p for p in out if p is not None]
+
+
 def _cycle_timing(scene):
     """Steps per cycle, dt and steps of a cycle-jumping run: dt is adjusted so
     a cycle is a whole number of steps, and the duration rounded to whole steps."""
@@ -265,8 +274,7 @@ def _cycle_timing(scene):
             raise SceneError(scene.source, f"body[{j}].motion", "'free' bodies have no cycle to "
                              "jump over; wear.acceleration = 'cycle_jump' needs guided, "
                              "prescribed or fixed bodies")
-    periods = [Path(b.path).period for b in scene.bodies if b.path is not None]
-    period = scene.wear.period or max(p for p in periods if p is not None)
+    period = scene.wear.period or max(_periods(scene))
     cycle_steps = max(1, int(round(period / scene.run.dt)))
     dt = period / cycle_steps
     n_steps = max(1, int(round(scene.run.duration / dt)))

@@ -438,3 +438,66 @@ def test_smoothed_normals_blend_across_facets_but_not_across_creases():
     assert np.abs(corners[wall][..., 2]).max() < 1e-12
     assert np.abs(corners[wall][..., 0:2] - radial).max() < 1e-9
     assert np.abs(np.abs(corners[~wall][..., 2]) - 1.0).max() < 1e-12
+
+
+# ------------------------------------------------- runs, outputs and resume
+
+def test_turning_disc_cycle_jump_resumes_to_the_same_wear_and_writes_its_series(tmp_path):
+    """Cycle jumping takes its period from the disc's turn (2π/10 s); a run
+    stopped at a checkpoint and resumed gives the same wear; the CLI writes
+    the moving disc as its own series, one frame per frame."""
+    import dataclasses
+    import json
+    import xml.etree.ElementTree as ET
+
+    from meshwear import checkpoint
+    from meshwear.cli import main
+    from meshwear.model import build_model, initial_state
+    from meshwear.simulate import run
+
+    path = tmp_path / "disc.toml"
+    path.write_text(PIN_ON_DISC.format(duration=30.0)
+                    .replace('law = "archard"', 'law = "archard"\nacceleration = "cycle_jump"')
+                    .replace("coefficient = 1e-12", "coefficient = 1e-14")
+                    .replace("history = 11", "history = 3"))
+    scene = load_scene(path)
+    model = build_model(scene)
+    assert model.cycle_steps == round(2 * np.pi / 10 / 1e-3)
+    full = run(model, initial_state(model))
+    assert full.jump.jumps > 0
+
+    class Stop(Exception):
+        pass
+
+    class KillAt:
+        def on_sample(self, model, state):
+            if state.time >= 14.0:
+                raise Stop
+
+        def on_frame(self, model, state):
+            pass
+
+    saver = checkpoint.Checkpointer(tmp_path, every=0.0)
+    with pytest.raises(Stop):
+        run(model, initial_state(model), observers=[KillAt()], checkpoint=saver)
+    resumed = initial_state(model)
+    checkpoint.load(saver.path, model, resumed)
+    assert 0.0 < resumed.time < 15.0 and resumed.jump.jumps > 0
+    run(model, resumed)
+    w, w_full = resumed.bodies[0].wear_depth, full.bodies[0].wear_depth
+    assert np.abs(w - w_full).max() <= 1e-9 * w_full.max()
+    load = 10.0 + model.bodies[0].mass * 9.81
+    volume = resumed.bodies[0].wear_volume.sum()
+    assert volume == pytest.approx(1e-14 * load * 0.3 * model.n_steps * model.dt, rel=2e-2)
+    assert full.jump.resolved_steps < model.n_steps / 4
+
+    short = tmp_path / "short.toml"
+    short.write_text(PIN_ON_DISC.format(duration=0.2).replace("frames = 0", "frames = 3"))
+    out = tmp_path / "out"
+    assert main(["run", str(short), "-o", str(out), "-q"]) == 0
+    frames = ET.parse(out / "disc.pvd").getroot().findall(".//DataSet")
+    assert len(frames) == 3 and all((out / f.get("file")).is_file() for f in frames)
+    summary = json.loads((out / "summary.json").read_text())
+    pin = summary["bodies"]["pin"]
+    assert 0 < pin["contact_points"] <= pin["active_vertices"] < pin["vertices"]
+    del dataclasses

@@ -39,6 +39,16 @@ class RunRecorder:
             patch = PVDSeries(self.out_dir, plane.name, faces)
             patch.write_frame(0.0, vertices, {})
             patch.close()
+        # mesh counter-surfaces: one frame if they stay put, else one per frame
+        self.moving = {}
+        for mesh in model.surfaces.meshes:
+            if mesh.period is None and not mesh.path.terms.size:
+                still = PVDSeries(self.out_dir, mesh.name, mesh.faces)
+                still.write_frame(0.0, mesh.world_vertices(0.0), {})
+                still.close()
+            else:
+                self.moving[mesh.name] = (mesh, PVDSeries(self.out_dir, mesh.name, mesh.faces,
+                                                          resume_until))
 
     def on_sample(self, model, state):
         for body, s in zip(model.bodies, state.bodies):
@@ -59,10 +69,14 @@ class RunRecorder:
         for body, s in zip(model.bodies, state.bodies):
             q = body_quantities(body, s, model)
             self.series[body.name].write_frame(state.time, q["points"], {k: q[k] for k in FIELDS})
+        for mesh, series in self.moving.values():
+            series.write_frame(state.time, mesh.world_vertices(state.time), {})
 
     def close(self, summary):
         self.history.close()
         for series in self.series.values():
+            series.close()
+        for _, series in self.moving.values():
             series.close()
         write_json_atomic(self.out_dir / "summary.json", summary)
 
@@ -102,6 +116,7 @@ def summary(model, state, wall_time, status="ok", message=None):
             "contact_force": s.wrench[0:3].tolist(),
             "contact_points": int((q["contact_state"] > 0).sum()),
             "vertices": int(len(s.wear_depth)),
+            "active_vertices": int(len(s.active)),
         }
     return out
 
