@@ -42,6 +42,7 @@ def save(path, model, state, wall_time):
         for name in _BODY_ARRAYS:
             arrays[f"body{k}_{name}"] = getattr(s, name)
         arrays[f"body{k}_active"] = s.active
+        arrays[f"body{k}_active_wear"] = s.active_wear
     js = state.jump
     if js is not None:
         arrays["jump_scalars"] = np.array([js.gap, js.last_jump, js.jumps, js.resolved_steps,
@@ -96,6 +97,7 @@ def load(path, model, state):
             for name in _BODY_ARRAYS:
                 getattr(s, name)[...] = data[f"body{k}_{name}"]
             s.active = data[f"body{k}_active"].astype(np.int64)
+            s.active_wear = data[f"body{k}_active_wear"].copy()
     except (KeyError, ValueError) as err:
         raise SceneError(model.scene.source, "", f"{path} was written by another version of "
                          f"meshwear ({err}); run without --resume to start again") from None

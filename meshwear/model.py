@@ -142,8 +142,10 @@ class BodyState:
         Per mesh surface, the plane of the face under each active vertex.
     active : (k,) int64
         The vertices within reach of a surface (:mod:`meshwear.surfaces`).
-    cull : (10,) float
-        Margin, time, pose and wear depth of the last active-set refresh.
+    active_wear : (k,) float
+        Their wear depth when the active set was last refreshed.
+    cull : (9,) float
+        Margin, time and pose of the last active-set refresh.
     """
 
     pose: np.ndarray
@@ -157,6 +159,7 @@ class BodyState:
     wrench: np.ndarray = field(default_factory=lambda: np.zeros(6))
     vertex_planes: np.ndarray = None
     active: np.ndarray = None
+    active_wear: np.ndarray = None
     cull: np.ndarray = None
     cull_scratch: object = None
 
@@ -417,7 +420,7 @@ def initial_state(model):
             wear_depth=np.zeros(n), friction_work=np.zeros(n), wear_volume=np.zeros(n),
             contact_state=np.zeros((S, n), dtype=np.int8),
             tangential=np.zeros((S, n, 4, 3)), normal_force=np.zeros((S, n)),
-            vertex_planes=np.zeros((M, n, 3, 3)), active=all_vertices(n),
+            vertex_planes=np.zeros((M, n, 3, 3)), active=all_vertices(n), active_wear=np.zeros(n),
             cull=np.zeros(surfaces.CULL_SIZE),
             cull_scratch=surfaces.Cull(np.zeros(n), np.zeros((n, 3, 3)) if M else None)))
     state = State(time=0.0, step=0, bodies=bodies)

@@ -35,11 +35,11 @@ MARGIN_FRACTION = 0.01
 
 #: the margin is at least this many times the largest relative motion of one
 #: step, so a vertex always meets a surface within reach before it touches
-STEPS_IN_MARGIN = 4.0
+STEPS_IN_MARGIN = 10.0
 
 #: slots of :attr:`meshwear.model.BodyState.cull`
-CULL_MARGIN, CULL_TIME, CULL_POSE, CULL_WEAR = 0, 1, slice(2, 9), 9
-CULL_SIZE = 10
+CULL_MARGIN, CULL_TIME, CULL_POSE = 0, 1, slice(2, 9)
+CULL_SIZE = 9
 
 
 def _bvh(vertices, faces):
@@ -256,7 +256,8 @@ def _step_motion(model, body, s, t):
 
 def moved_since_refresh(model, body, s, t):
     """Upper bound (m) on how far any vertex of ``body`` has come towards any
-    surface since the active set was refreshed, wear included."""
+    surface since the active set was refreshed, wear included. O(active
+    vertices): it is checked every step."""
     cull = s.cull
     pose0, t0 = cull[CULL_POSE], cull[CULL_TIME]
     turn = _rotation_angle(s.pose[3:7], pose0[3:7])
@@ -269,7 +270,9 @@ def moved_since_refresh(model, body, s, t):
         body_motion = float(np.linalg.norm(shift)) + spin
         bound = max(bound, body_motion + max(m.displacement_bound(t0, t)
                                              for m in model.surfaces.meshes))
-    return bound + float(s.wear_depth.max()) - cull[CULL_WEAR]
+    # only active vertices wear: the largest wear since the refresh among them
+    worn = float((s.wear_depth[s.active] - s.active_wear).max()) if len(s.active) else 0.0
+    return bound + worn
 
 
 def refresh(model, body, s, t):
@@ -283,7 +286,6 @@ def refresh(model, body, s, t):
     near = np.zeros(len(x), dtype=bool)
     for p in surfaces.planes:
         near |= (x - p[0]) @ p[1] < margin
-    P = surfaces.planes.shape[0]
     for j in surfaces.meshes_within(body, s.pose, t, margin):
         mesh = surfaces.meshes[j]
         mesh.ensure_reach(margin)
@@ -306,19 +308,16 @@ def refresh(model, body, s, t):
     s.cull[CULL_MARGIN] = margin
     s.cull[CULL_TIME] = t
     s.cull[CULL_POSE] = s.pose[0:7]
-    s.cull[CULL_WEAR] = float(s.wear_depth.max())
-    del P
+    s.active_wear = s.wear_depth[active]
 
 
 def update(model, body, s, t):
     """Before a step at time ``t``: refresh the active set of ``body`` if its
     bound is reached, then give its active vertices the planes of the mesh
     surfaces at ``t``."""
-    if not model.cull:
-        pass
-    elif (s.cull[CULL_MARGIN] == 0.0
-          or moved_since_refresh(model, body, s, t) + _step_motion(model, body, s, t)
-          >= s.cull[CULL_MARGIN]):
+    if model.cull and (s.cull[CULL_MARGIN] == 0.0
+                       or moved_since_refresh(model, body, s, t) + _step_motion(model, body, s, t)
+                       >= s.cull[CULL_MARGIN]):
         refresh(model, body, s, t)
     query_meshes(model, body, s, t)
 

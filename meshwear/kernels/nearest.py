@@ -146,6 +146,14 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             f = items[j]
             fx, fy, fz = face_normals[f, 0], face_normals[f, 1], face_normals[f, 2]
             a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+            delta = ((yx - counter_vertices[a, 0]) * fx + (yy - counter_vertices[a, 1]) * fy
+                     + (yz - counter_vertices[a, 2]) * fz)
+            # the face is at least as far as its plane: skip it unless it can
+            # be within reach and nearer than the faces found so far
+            plane2 = delta * delta
+            if plane2 > reach2 or (plane2 > best_d2 * (1.0 + 2.0 * TIE)
+                                   and (not tracked or plane2 > kept_d2 * (1.0 + 2.0 * TIE))):
+                continue
             cx, cy, cz, cu, cv, cw = closest_on_triangle(
                 yx, yy, yz,
                 counter_vertices[a, 0], counter_vertices[a, 1], counter_vertices[a, 2],
@@ -154,8 +162,6 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             d2 = (yx - cx) ** 2 + (yy - cy) ** 2 + (yz - cz) ** 2
             if d2 > reach2:
                 continue
-            delta = ((yx - counter_vertices[a, 0]) * fx + (yy - counter_vertices[a, 1]) * fy
-                     + (yz - counter_vertices[a, 2]) * fz)
             tie = TIE * max(d2, best_d2 if best >= 0 else d2)
             if best < 0 or d2 < best_d2 - tie or (d2 <= best_d2 + tie and delta > best_delta):
                 best, best_d2, best_delta = f, d2, delta
