@@ -27,7 +27,7 @@ import numpy as np
 
 from . import geometry
 from .kernels.contact import FORCE, NO_CONTACT, rotation_entries
-from .kernels.nearest import build_grid, corner_normals, nearest_planes
+from .kernels.nearest import build_grid, corner_normals, face_frames, nearest_planes
 from .motion import Path
 
 #: default active-set margin, as a fraction of a body's bounding-box diagonal
@@ -77,6 +77,7 @@ class MeshSurface:
         self.name = name
         self.vertices, self.faces = geometry._arrays(vertices, faces)
         self.face_normals = np.ascontiguousarray(geometry.face_normals(self.vertices, self.faces))
+        self.frames = face_frames(self.vertices, self.faces)
         self.corner_normals = (corner_normals(self.vertices, self.faces, self.face_normals)
                                if smooth_normals else np.zeros((0, 3, 3)))
         self.position = np.asarray(position, float)
@@ -144,7 +145,7 @@ class MeshSurface:
         rotation, motion = self.frame(t)
         grid, keys, starts, items = self.grid
         nearest_planes(vertices, pose, active, rotation, motion, self.vertices, self.faces,
-                       self.face_normals, self.corner_normals, grid, keys, starts, items,
+                       self.frames, self.corner_normals, grid, keys, starts, items,
                        out, distance)
 
     def transform(self, t):
@@ -348,7 +349,7 @@ def _planes_at(body_vertices, pose, meshes, reach):
         grid, keys, starts, items = build_grid(mesh.vertices, mesh.faces, mesh.face_normals, reach)
         rotation, motion = mesh.frame(0.0)
         nearest_planes(body_vertices, pose, all_vertices(n), rotation, motion, mesh.vertices,
-                       mesh.faces, mesh.face_normals, mesh.corner_normals, grid, keys, starts,
+                       mesh.faces, mesh.frames, mesh.corner_normals, grid, keys, starts,
                        items, out[j], distance[j])
     return out, distance
 

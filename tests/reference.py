@@ -286,7 +286,10 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
             near = ok & (d2 <= d2[best] * (1 + tie))
             return np.flatnonzero(near)[np.argmax(delta[near])]
 
-        over = d2 - delta ** 2 <= 1e-12 * d2
+        # the foot on the plane, and how far it lies outside the triangle
+        foot = points - delta[:, None] * face_normals
+        lateral = np.linalg.norm(closest_points(tri, foot)[0] - foot, axis=1)
+        over = lateral <= 1e-9 * reach
         kept = pick(within & over & (face_normals @ prev >= tracking)) \
             if tracked else -1
         best = kept if kept >= 0 else pick(within)

@@ -70,8 +70,8 @@ def test_nearest_planes_match_brute_force_twin(smooth):
     guess = directions @ rotation.T + rng.normal(scale=0.4, size=(n, 3))
     out[tracked, 1] = (guess / np.linalg.norm(guess, axis=1)[:, None])[tracked]
     twin_out, distance, twin_distance = out.copy(), np.full(n, -1.0), np.full(n, -1.0)
-    nearest.nearest_planes(body, pose, active, rotation, motion, V, F, normals, vnormals, *grid,
-                           out, distance)
+    nearest.nearest_planes(body, pose, active, rotation, motion, V, F,
+                           nearest.face_frames(V, F), vnormals, *grid, out, distance)
     reference.nearest_planes(body, pose, active, rotation, motion, V, F, normals, vnormals, reach,
                              twin_out, twin_distance)
     assert _close(out, twin_out)
@@ -100,7 +100,10 @@ def test_grid_cells_list_every_face_within_reach():
         idx = ((p - grid[0:3]) // grid[3]).astype(int)
         key = idx[0] + int(grid[4]) * (idx[1] + int(grid[5]) * idx[2])
         j = np.searchsorted(keys, key)
-        listed = set(items[starts[j]:starts[j + 1]]) if j < len(keys) and keys[j] == key else set()
+        if len(keys) == 0:
+            listed = set(items[starts[key]:starts[key + 1]])
+        else:
+            listed = set(items[starts[j]:starts[j + 1]]) if j < len(keys) and keys[j] == key else set()
         assert set(np.flatnonzero(d <= reach)) <= listed
 
 

@@ -15,9 +15,11 @@ rotation : (3, 3)
 motion : (4, 3)
     World position of the counter frame's origin (m), translational velocity
     (m/s), angular velocity (rad/s) and the point the rotation is about (m).
-counter_vertices : (V, 3), faces : (F, 3) int64, face_normals : (F, 3)
-    The counter mesh in its frame, normals pointing out of it (into the worn
-    bodies).
+counter_vertices : (V, 3), faces : (F, 3) int64
+    The counter mesh in its frame, its faces' normals pointing out of it (into
+    the worn bodies).
+frames : (F, 4, 4)
+    Each face's plane and edge lines (:func:`face_frames`).
 corner_normals : (F, 3, 3) or (0, 3, 3)
     Unit normals at each face's corners to interpolate over the face
     (smoothed normals, :func:`corner_normals`), or empty for the face normal.
@@ -25,7 +27,8 @@ grid : (9,)
     Origin (3), cell size, cells along x, y, z, reach (m), unused.
 keys : (C,) int64, starts : (C + 1,) int64, items : (E,) int64
     Sorted keys of the non-empty cells, and the faces of cell ``j`` as
-    ``items[starts[j]:starts[j + 1]]``.
+    ``items[starts[j]:starts[j + 1]]``; ``keys`` empty for a dense grid, where
+    ``j`` is the cell's key itself.
 """
 
 import numpy as np
@@ -47,10 +50,10 @@ TIE = 1e-9
 #: nearest face, as an untracked vertex does.
 TRACKING = 0.5
 
-#: a vertex is over a face (its foot on the face's plane lies in the closed
-#: triangle) when its distance to the face exceeds its distance to the plane
-#: by less than this relative amount (an edge between two faces belongs to both)
-OVER = 1e-12
+#: a vertex is over a face when the foot of it on the face's plane lies in
+#: the triangle or less than this fraction of the reach outside it (an edge
+#: between two faces belongs to both)
+OVER = 1e-9
 
 
 @njit(cache=True, inline="always")
@@ -104,17 +107,27 @@ def _cell_range(yx, yy, yz, grid, keys, starts):
     if ix < 0 or iy < 0 or iz < 0 or ix >= nx or iy >= ny or iz >= nz:
         return 0, 0
     key = ix + nx * (iy + ny * iz)
+    if keys.shape[0] == 0:           # a dense grid: every cell has its slot
+        return starts[key], starts[key + 1]
     j = np.searchsorted(keys, key)
     if j >= keys.shape[0] or keys[j] != key:
         return 0, 0
     return starts[j], starts[j + 1]
 
 
+@njit(cache=True, inline="always")
+def _along(frames, f, row, x, y, z):
+    """Signed distance of (x, y, z) past line/plane ``row`` of face ``f``'s frame."""
+    return frames[f, row, 0] * x + frames[f, row, 1] * y + frames[f, row, 2] * z - frames[f, row, 3]
+
+
 def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-                    face_normals, corner_normals, grid, keys, starts, items, out, distance):
+                    frames, corner_normals, grid, keys, starts, items, out, distance):
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
     smooth = corner_normals.shape[0] > 0
     reach2 = grid[7] * grid[7]
+    over = OVER * grid[7]
+    grow = 1.0 + 2.0 * TIE
     for k in prange(active.shape[0]):
         i = active[k]
         bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
@@ -140,41 +153,42 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
         best = kept = -1
         best_d2 = kept_d2 = np.inf
         best_delta = kept_delta = -np.inf
-        qx = qy = qz = u = v = w = 0.0
-        kx = ky = kz = ku = kv = kw = 0.0
         for j in range(lo, hi):
             f = items[j]
-            fx, fy, fz = face_normals[f, 0], face_normals[f, 1], face_normals[f, 2]
-            a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-            delta = ((yx - counter_vertices[a, 0]) * fx + (yy - counter_vertices[a, 1]) * fy
-                     + (yz - counter_vertices[a, 2]) * fz)
-            # the face is at least as far as its plane: skip it unless it can
-            # be within reach and nearer than the faces found so far
+            delta = _along(frames, f, 0, yx, yy, yz)
             plane2 = delta * delta
-            if plane2 > reach2 or (plane2 > best_d2 * (1.0 + 2.0 * TIE)
-                                   and (not tracked or plane2 > kept_d2 * (1.0 + 2.0 * TIE))):
+            if plane2 > reach2:
                 continue
-            cx, cy, cz, cu, cv, cw = closest_on_triangle(
-                yx, yy, yz,
-                counter_vertices[a, 0], counter_vertices[a, 1], counter_vertices[a, 2],
-                counter_vertices[b, 0], counter_vertices[b, 1], counter_vertices[b, 2],
-                counter_vertices[c, 0], counter_vertices[c, 1], counter_vertices[c, 2])
-            d2 = (yx - cx) ** 2 + (yy - cy) ** 2 + (yz - cz) ** 2
-            if d2 > reach2:
+            # how far the foot of y on the plane lies outside the triangle's
+            # edges: its distance to the face is at least that
+            outside = max(_along(frames, f, 1, yx, yy, yz), _along(frames, f, 2, yx, yy, yz),
+                          _along(frames, f, 3, yx, yy, yz))
+            bound = plane2 + outside * outside if outside > 0.0 else plane2
+            if bound > reach2 or (bound > best_d2 * grow
+                                  and (not tracked or bound > kept_d2 * grow)):
                 continue
+            if outside <= 0.0:
+                d2 = plane2        # the foot is on the face
+            else:
+                a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+                cx, cy, cz, cu, cv, cw = closest_on_triangle(
+                    yx, yy, yz,
+                    counter_vertices[a, 0], counter_vertices[a, 1], counter_vertices[a, 2],
+                    counter_vertices[b, 0], counter_vertices[b, 1], counter_vertices[b, 2],
+                    counter_vertices[c, 0], counter_vertices[c, 1], counter_vertices[c, 2])
+                d2 = (yx - cx) ** 2 + (yy - cy) ** 2 + (yz - cz) ** 2
+                if d2 > reach2:
+                    continue
             tie = TIE * max(d2, best_d2 if best >= 0 else d2)
             if best < 0 or d2 < best_d2 - tie or (d2 <= best_d2 + tie and delta > best_delta):
                 best, best_d2, best_delta = f, d2, delta
-                qx, qy, qz, u, v, w = cx, cy, cz, cu, cv, cw
-            if (tracked and d2 - delta * delta <= OVER * d2
-                    and fx * tx + fy * ty + fz * tz >= TRACKING):
+            if (tracked and outside <= over
+                    and _along(frames, f, 0, tx, ty, tz) + frames[f, 0, 3] >= TRACKING):
                 tie = TIE * max(d2, kept_d2 if kept >= 0 else d2)
                 if kept < 0 or d2 < kept_d2 - tie or (d2 <= kept_d2 + tie and delta > kept_delta):
                     kept, kept_d2, kept_delta = f, d2, delta
-                    kx, ky, kz, ku, kv, kw = cx, cy, cz, cu, cv, cw
         if kept >= 0:
             best, best_d2, best_delta = kept, kept_d2, kept_delta
-            qx, qy, qz, u, v, w = kx, ky, kz, ku, kv, kw
         if best < 0:
             for row in range(3):
                 for col in range(3):
@@ -182,7 +196,15 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             distance[i] = np.inf
             continue
         distance[i] = np.sqrt(best_d2)
+        hx, hy, hz = frames[best, 0, 0], frames[best, 0, 1], frames[best, 0, 2]
         if smooth:
+            # the normal interpolated at the closest point of the face
+            a, b, c = faces[best, 0], faces[best, 1], faces[best, 2]
+            qx, qy, qz, u, v, w = closest_on_triangle(
+                yx, yy, yz,
+                counter_vertices[a, 0], counter_vertices[a, 1], counter_vertices[a, 2],
+                counter_vertices[b, 0], counter_vertices[b, 1], counter_vertices[b, 2],
+                counter_vertices[c, 0], counter_vertices[c, 1], counter_vertices[c, 2])
             cn = corner_normals[best]
             hx = u * cn[0, 0] + v * cn[1, 0] + w * cn[2, 0]
             hy = u * cn[0, 1] + v * cn[1, 1] + w * cn[2, 1]
@@ -190,7 +212,6 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             length = np.sqrt(hx * hx + hy * hy + hz * hz)
             hx, hy, hz = hx / length, hy / length, hz / length
         else:
-            hx, hy, hz = face_normals[best, 0], face_normals[best, 1], face_normals[best, 2]
             # the face's plane: the foot of y on it (its closest point when
             # that is inside the face)
             qx, qy, qz = yx - best_delta * hx, yy - best_delta * hy, yz - best_delta * hz
@@ -208,8 +229,30 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
         out[i, 2, 2] = motion[1, 2] + motion[2, 0] * ly - motion[2, 1] * lx
 
 
-nearest_planes_serial = njit(cache=True)(_named_copy(_nearest_planes, "nearest_planes_serial"))
-nearest_planes_parallel = njit(cache=True, parallel=True)(
+def face_frames(vertices, faces):
+    """(F, 4, 4) per face: its unit normal and offset (``n . y - offset`` is the
+    signed distance of y to the plane), then for each edge the unit in-plane
+    normal pointing out of the triangle and its offset (positive: the foot of
+    y lies beyond that edge, by that much)."""
+    tri = vertices[faces]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    out = np.zeros((len(faces), 4, 4))
+    out[:, 0, 0:3] = n
+    out[:, 0, 3] = np.einsum("ij,ij->i", n, tri[:, 0])
+    for k in range(3):
+        p, q = tri[:, k], tri[:, (k + 1) % 3]
+        m = np.cross(q - p, n)           # in the plane, away from the triangle (counter-clockwise)
+        m /= np.linalg.norm(m, axis=1)[:, None]
+        out[:, k + 1, 0:3] = m
+        out[:, k + 1, 3] = np.einsum("ij,ij->i", m, p)
+    return np.ascontiguousarray(out)
+
+
+# fastmath "contract" only, as the contact kernel (FMA; IEEE NaN and infinity kept)
+nearest_planes_serial = njit(cache=True, fastmath={"contract"})(
+    _named_copy(_nearest_planes, "nearest_planes_serial"))
+nearest_planes_parallel = njit(cache=True, parallel=True, fastmath={"contract"})(
     _named_copy(_nearest_planes, "nearest_planes_parallel"))
 
 #: active vertices from which the threaded query pays for its threads
@@ -217,7 +260,7 @@ PARALLEL_THRESHOLD = 2048
 
 
 def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-                   face_normals, corner_normals, grid, keys, starts, items, out, distance):
+                   frames, corner_normals, grid, keys, starts, items, out, distance):
     """For each ``active`` vertex ``i`` of a body at ``pose``, write to
     ``out[i]`` (3, 3) the plane of its nearest counter face within the grid's
     reach (``grid[7]``) (point, normal, counter velocity there; world) and to
@@ -228,7 +271,7 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
     kernel = (nearest_planes_parallel if active.shape[0] >= PARALLEL_THRESHOLD
               else nearest_planes_serial)
     kernel(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-           face_normals, corner_normals, grid, keys, starts, items, out, distance)
+           frames, corner_normals, grid, keys, starts, items, out, distance)
 
 
 #: faces meeting at a vertex at more than 60 degrees are a crease: smoothed
@@ -244,7 +287,8 @@ def corner_normals(vertices, faces, normals):
     tri = vertices[faces]
     e1 = np.roll(tri, -1, axis=1) - tri
     e2 = np.roll(tri, 1, axis=1) - tri
-    cos = np.einsum("fkj,fkj->fk", e1, e2) / (np.linalg.norm(e1, axis=2) * np.linalg.norm(e2, axis=2))
+    lengths = np.linalg.norm(e1, axis=2) * np.linalg.norm(e2, axis=2)
+    cos = np.einsum("fkj,fkj->fk", e1, e2) / lengths
     angle = np.arccos(np.clip(cos, -1.0, 1.0)).ravel()   # per corner
     corner_vertex = faces.ravel()
     corner_face = np.repeat(np.arange(len(faces)), 3)
@@ -264,6 +308,10 @@ def corner_normals(vertices, faces, normals):
     out /= np.linalg.norm(out, axis=1)[:, None]
     return np.ascontiguousarray(out.reshape(len(faces), 3, 3))
 
+
+#: grids of at most this many cells keep a slot per cell (8 bytes each); larger
+#: ones list their non-empty cells and search them
+DENSE_CELLS = 4_000_000
 
 #: largest number of (cell, face) entries a grid may hold; the cells grow past it
 MAX_ENTRIES = 5_000_000
@@ -315,7 +363,12 @@ def build_grid(vertices, faces, normals, reach, cell=None):
     face_of = face_of[keep]
     order = np.lexsort((face_of, key))
     key, face_of = key[order], face_of[order]
+    grid = np.array([lo[0], lo[1], lo[2], h, dims[0], dims[1], dims[2], reach, 0.0])
+    cells = int(np.prod(dims))
+    if cells <= DENSE_CELLS:
+        # a slot per cell: a lookup is one index, no search
+        starts = np.searchsorted(key, np.arange(cells + 1)).astype(np.int64)
+        return grid, np.zeros(0, dtype=np.int64), starts, face_of.astype(np.int64)
     keys, first_index = np.unique(key, return_index=True)
     starts = np.append(first_index, len(key)).astype(np.int64)
-    grid = np.array([lo[0], lo[1], lo[2], h, dims[0], dims[1], dims[2], reach, 0.0])
     return grid, keys.astype(np.int64), starts, face_of.astype(np.int64)
