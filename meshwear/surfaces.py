@@ -98,6 +98,9 @@ class MeshSurface:
         self.bvh = fcl.CollisionObject(self.geometry, fcl.Transform())
         self.rotation = np.eye(3)
         self.motion = np.zeros((4, 3))
+        #: a surface that stays put: its frame is computed once
+        self.static = self.rate == 0.0 and not self.path.terms.size
+        self._frame_time = None
 
     @property
     def period(self):
@@ -116,6 +119,9 @@ class MeshSurface:
         """Set :attr:`rotation` (3, 3) and :attr:`motion` (4, 3) to the
         surface's pose and velocity at time ``t`` (arrays of
         :mod:`meshwear.kernels.nearest`); return them."""
+        if self.static and self._frame_time is not None:
+            return self.rotation, self.motion
+        self._frame_time = t
         turn = _axis_rotation(self.axis, self.rate * t)
         shift = self.path.displacement(t)
         self.rotation[:] = turn @ self.R0
@@ -131,12 +137,16 @@ class MeshSurface:
 
     def displacement_bound(self, t0, t1):
         """Upper bound (m) on how far any point of the surface moves from ``t0`` to ``t1``."""
+        if self.static:
+            return 0.0
         turn = min(np.pi, abs(self.rate) * abs(t1 - t0))
         shift = np.linalg.norm(self.path.displacement(t1) - self.path.displacement(t0))
         return float(shift + 2.0 * np.sin(0.5 * turn) * self.radius)
 
     def speed_bound(self, t):
         """Upper bound (m/s) on the speed of any point of the surface at ``t``."""
+        if self.static:
+            return 0.0
         return float(np.linalg.norm(self.path.velocity(t)) + abs(self.rate) * self.radius)
 
     def query(self, vertices, pose, active, out, distance, t):

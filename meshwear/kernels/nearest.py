@@ -327,30 +327,65 @@ def build_grid(vertices, faces, normals, reach, cell=None):
     reach : float
         m; queries find every face within it.
     cell : float, optional
-        Cell size (m); default twice the reach or the median edge length,
-        whichever is larger, grown until the grid fits :data:`MAX_ENTRIES`.
+        Cell size (m). By default the size, among a few around the median
+        edge length (and at least the reach), whose cells list the fewest faces
+        where faces are (the expected faces per query), within
+        :data:`MAX_ENTRIES`.
 
     Returns
     -------
     grid, keys, starts, items : the arrays :func:`nearest_planes` takes.
     """
     tri = vertices[faces]
-    edges = np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2)
-    h = float(cell) if cell else max(2.0 * reach, float(np.median(edges)))
     lo = vertices.min(axis=0) - reach - 1e-9
     span = vertices.max(axis=0) + reach + 1e-9 - lo
-    while True:
-        dims = np.maximum(1, np.ceil(span / h)).astype(np.int64)
-        first = np.floor((tri.min(axis=1) - reach - lo) / h).astype(np.int64)
-        last = np.floor((tri.max(axis=1) + reach - lo) / h).astype(np.int64)
-        first, last = np.clip(first, 0, dims - 1), np.clip(last, 0, dims - 1)
-        counts = np.prod(last - first + 1, axis=1)
-        if counts.sum() <= MAX_ENTRIES:
-            break
+    if cell:
+        sizes = [float(cell)]
+    else:
+        edges = np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2)
+        base = max(reach, float(np.median(edges)))
+        sizes = [base * f for f in (0.5, 0.75, 1.0, 1.5, 2.0, 3.0)]
+    best = None
+    for h in sizes:
+        binned = _bin(tri, normals, lo, span, reach, h)
+        if binned is None:
+            continue
+        key = binned[1]
+        per_cell = np.unique(key, return_counts=True)[1]
+        score = float((per_cell ** 2).sum() / max(per_cell.sum(), 1))
+        if best is None or score < best[0]:
+            best = (score, binned)
+    h = sizes[-1]
+    while best is None:               # every size too fine for MAX_ENTRIES: grow
         h *= 1.5
+        binned = _bin(tri, normals, lo, span, reach, h)
+        if binned is not None:
+            best = (0.0, binned)
+    h, key, face_of, dims = best[1]
+    grid = np.array([lo[0], lo[1], lo[2], h, dims[0], dims[1], dims[2], reach, 0.0])
+    cells = int(np.prod(dims))
+    if cells <= DENSE_CELLS:
+        # a slot per cell: a lookup is one index, no search
+        starts = np.searchsorted(key, np.arange(cells + 1)).astype(np.int64)
+        return grid, np.zeros(0, dtype=np.int64), starts, face_of.astype(np.int64)
+    keys, first_index = np.unique(key, return_index=True)
+    starts = np.append(first_index, len(key)).astype(np.int64)
+    return grid, keys.astype(np.int64), starts, face_of.astype(np.int64)
+
+
+def _bin(tri, normals, lo, span, reach, h):
+    """(h, sorted cell keys, their faces, dims) of a grid of cell size ``h``,
+    or None if it would hold more than :data:`MAX_ENTRIES` entries."""
+    dims = np.maximum(1, np.ceil(span / h)).astype(np.int64)
+    first = np.floor((tri.min(axis=1) - reach - lo) / h).astype(np.int64)
+    last = np.floor((tri.max(axis=1) + reach - lo) / h).astype(np.int64)
+    first, last = np.clip(first, 0, dims - 1), np.clip(last, 0, dims - 1)
+    counts = np.prod(last - first + 1, axis=1)
+    if counts.sum() > MAX_ENTRIES:
+        return None
     # every cell of each face's box, kept where the face's plane passes within
     # reach of the cell (a long slanted CAD triangle spans a thin slab of its box)
-    face_of = np.repeat(np.arange(len(faces)), counts)
+    face_of = np.repeat(np.arange(len(tri)), counts)
     offset = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
     size = (last - first + 1)[face_of]
     ix = first[face_of, 0] + offset % size[:, 0]
@@ -362,13 +397,4 @@ def build_grid(vertices, faces, normals, reach, cell=None):
     key = (ix + dims[0] * (iy + dims[1] * iz))[keep]
     face_of = face_of[keep]
     order = np.lexsort((face_of, key))
-    key, face_of = key[order], face_of[order]
-    grid = np.array([lo[0], lo[1], lo[2], h, dims[0], dims[1], dims[2], reach, 0.0])
-    cells = int(np.prod(dims))
-    if cells <= DENSE_CELLS:
-        # a slot per cell: a lookup is one index, no search
-        starts = np.searchsorted(key, np.arange(cells + 1)).astype(np.int64)
-        return grid, np.zeros(0, dtype=np.int64), starts, face_of.astype(np.int64)
-    keys, first_index = np.unique(key, return_index=True)
-    starts = np.append(first_index, len(key)).astype(np.int64)
-    return grid, keys.astype(np.int64), starts, face_of.astype(np.int64)
+    return h, key[order], face_of[order], dims

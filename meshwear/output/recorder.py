@@ -42,7 +42,7 @@ class RunRecorder:
         # mesh counter-surfaces: one frame if they stay put, else one per frame
         self.moving = {}
         for mesh in model.surfaces.meshes:
-            if mesh.period is None and not mesh.path.terms.size:
+            if mesh.static:
                 still = PVDSeries(self.out_dir, mesh.name, mesh.faces)
                 still.write_frame(0.0, mesh.world_vertices(0.0), {})
                 still.close()
