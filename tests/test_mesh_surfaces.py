@@ -533,3 +533,76 @@ def test_the_active_set_changes_no_result(tmp_path):
     n = len(on.wear_depth)
     assert rows_off["active"].min() == n
     assert np.median(rows_on["active"]) < 0.5 * n
+
+
+def test_cad_part_example_refines_only_where_it_can_touch_and_wears_k_load_distance():
+    """examples/cad_part.toml: the CAD shoe (58 vertices, slivers up to aspect
+    ~40) is refined to 0.5 mm on its running face and chamfers only; a few
+    strokes on the rail mesh wear V = k P s (gross sliding)."""
+    import dataclasses
+
+    from meshwear.geometry import face_normals, load_mesh
+    from meshwear.model import build_model, initial_state
+    from meshwear.simulate import run
+
+    root = __import__("pathlib").Path(__file__).resolve().parents[1]
+    scene = load_scene(root / "examples" / "cad_part.toml")
+    raw_vertices, raw_faces = load_mesh(root / "meshes" / "slider_shoe_mm.stl", "mm")
+    scene = dataclasses.replace(
+        scene, wear=dataclasses.replace(scene.wear, acceleration="none"),
+        run=dataclasses.replace(scene.run, duration=2.0, frames=0, history=3))
+    model = build_model(scene)
+    body = model.bodies[0]
+    V, F = body.reference_vertices, body.faces
+    normals = face_normals(V, F)
+    area = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+    edges = np.linalg.norm(V[F] - V[np.roll(F, 1, axis=1)], axis=2).max(axis=1)
+    facing = normals[:, 2] < -1e-3
+    # the faces that face the rail are refined to 0.5 mm; the crown keeps its
+    # 12 mm facets (a few split where the closure of the refinement reaches)
+    assert edges[facing].max() <= 5e-4 * (1 + 1e-9)
+    crown = normals[:, 2] > 0.5
+    assert np.median(edges[crown]) > 0.01 and crown.sum() < 2 * 2 * 24
+    assert len(V) > 20 * len(raw_vertices)
+    # the running face and chamfers carry the vertices; the area is all there
+    assert area[facing].sum() == pytest.approx(0.036 * 0.012 + 2 * 0.012 * np.hypot(0.002, 0.001),
+                                               rel=1e-9)
+    state = run(model, initial_state(model))
+    s = state.bodies[0]
+    load = 200.0 + body.mass * 9.81
+    distance = 4 * 0.01 * 2.0
+    assert s.wear_volume.sum() == pytest.approx(1e-16 * load * distance, rel=1e-2)
+    assert 0 < len(s.active) < len(V)
+
+
+def test_the_collision_manager_names_the_mesh_surfaces_a_body_comes_near(tmp_path):
+    """Three mesh surfaces, a block over one of them and near the edge of a
+    second: the fcl broad phase admits those two, within the margin only."""
+    text = BLOCK.format(duration=0.01, history=2, margin="", path=OSCILLATION, floor=BOX_FLOOR)
+    text += ('\n[[surface]]\nname = "far"\ntype = "mesh"\n'
+             'shape = { type = "box", size = [0.01, 0.01, 0.01] }\nposition = [0.5, 0.0, 0.0]\n'
+             '\n[[surface]]\nname = "beside"\ntype = "mesh"\n'
+             'shape = { type = "box", size = [0.01, 0.01, 0.01] }\n'
+             'position = [0.0, 0.0102, 0.0075]\n')
+    path = tmp_path / "three.toml"
+    path.write_text(text)
+    from meshwear.model import build_model
+
+    model = build_model(load_scene(path))
+    body = model.bodies[0]
+    pose = body.initial_pose
+    names = [m.name for m in model.surfaces.meshes]
+    near = model.surfaces.meshes_within
+    assert [names[j] for j in near(body, pose, 0.0, 1e-4)] == ["floor"]
+    assert [names[j] for j in near(body, pose, 0.0, 3e-4)] == ["floor", "beside"]
+    assert len(near(body, pose, 0.0, 1.0)) == 3
+
+
+@pytest.mark.parametrize("name", ["cad_part", "pin_on_turning_disc"])
+def test_mesh_surface_examples_check(name, capsys):
+    from meshwear.cli import main
+
+    root = __import__("pathlib").Path(__file__).resolve().parents[1]
+    assert main(["check", str(root / "examples" / f"{name}.toml")]) == 0
+    out = capsys.readouterr().out
+    assert "within reach of a surface" in out
