@@ -132,8 +132,8 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0):
               f"{len(model.frame_steps)} frames")
         for body in model.bodies:
             print(f"  ParaView series: {out_dir / (body.name + '.pvd')}")
-        for plane in model.plane_list:
-            print(f"  surface: {out_dir / (plane.name + '.pvd')}")
+        for surface in (*model.plane_list, *model.surfaces.meshes):
+            print(f"  surface: {out_dir / (surface.name + '.pvd')}")
         print(f"  history: {out_dir / 'history.csv'}, summary: {out_dir / 'summary.json'}")
     return EXIT_OK
 
@@ -152,6 +152,11 @@ def _check(scene_path):
               f"mass {mass}, motion {config.motion}")
     for p in model.plane_list:
         print(f"  plane {p.name!r}: point {p.point.tolist()}, normal {p.normal.tolist()}")
+    for m in model.surfaces.meshes:
+        moving = ("fixed" if m.static else
+                  f"turning at {m.rate:g} rad/s" if m.rate and not m.path.terms.size else "moving")
+        print(f"  mesh surface {m.name!r}: {len(m.vertices)} vertices, {len(m.faces)} faces, "
+              f"{moving}")
     stable = (f"largest stable dt {limit:.3g} s" if np.isfinite(limit)
               else "no stability limit (quasi-static)" if model.quasi_static
               else "no stability limit (nothing integrated in time)")
