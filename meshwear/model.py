@@ -191,7 +191,7 @@ def build_model(scene):
     for j, s in enumerate(scene.surfaces):
         if s.type == "mesh":
             try:
-                meshes.append(surfaces.build_mesh_surface(s, j, scene.source))
+                meshes.append(surfaces.build_mesh_surface(s))
             except geometry.MeshError as err:
                 key = f"surface[{j}].mesh" if s.mesh is not None else f"surface[{j}].shape"
                 raise SceneError(scene.source, key, str(err)) from None

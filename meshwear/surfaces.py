@@ -9,9 +9,9 @@ so the same point-plane contact applies.
 Active set. A worn body's vertices that are farther than a margin ``m`` from
 every surface cannot touch one until the body or a surface has moved by
 ``m`` relative to the other, or the body has worn by it; the contact kernel
-skips them. :func:`update` refreshes the set only when that bound (measured
-from the poses, so O(1) per step) is reached, and the per-step cost follows
-the contact region, not the mesh size.
+skips them. :func:`update` refreshes the set only when that bound (from the
+poses and the wear of the active vertices, so O(active vertices) per step) is
+reached, and the per-step cost follows the contact region, not the mesh size.
 
 python-fcl finds whether a worn body can meet a counter mesh at all: one BVH
 per mesh, built once from the unworn meshes (a worn body lies inside its unworn
@@ -163,7 +163,7 @@ class MeshSurface:
         return fcl.Transform(rotation.copy(), motion[0].copy())
 
 
-def build_mesh_surface(config, index, source):
+def build_mesh_surface(config):
     """A :class:`MeshSurface` from a validated ``[[surface]]`` of type mesh.
 
     Raises
@@ -194,9 +194,6 @@ class SurfaceSet:
         self.meshes = tuple(meshes)
         self.manager = None
         self.body_bvh = {}
-
-    def __len__(self):
-        return self.planes.shape[0] + len(self.meshes)
 
     def _manager(self, t):
         if self.manager is None:
