@@ -36,7 +36,7 @@ def make_case(n):
     pose = np.zeros(13)
     pose[3] = 1.0
     pose[2] = -1e-6
-    planes = np.zeros((1, 3, 3))
+    planes = np.zeros((1, 4, 3))
     planes[0, 1, 2] = 1.0
     params = np.zeros((n, 4))  # area vectors: 0.01 mm² each, facing the plane
     params[:, 2], params[:, 3] = -1e-8, 1e-8

@@ -21,13 +21,15 @@ from .scene import SceneError
 
 FILE_NAME = "checkpoint.npz"
 _BODY_ARRAYS = ("pose", "vertices", "wear_depth", "friction_work", "wear_volume",
-                "contact_state", "tangential", "normal_force", "wrench", "vertex_planes", "cull")
+                "contact_state", "tangential", "normal_force", "wrench", "vertex_planes", "hint",
+                "cull")
 
 
 def scene_digest(scene):
-    """SHA-256 of the scene file and every mesh file it reads."""
+    """SHA-256 of the scene file and every mesh file it reads (bodies' and surfaces')."""
     h = hashlib.sha256()
-    paths = [Path(scene.source)] + [Path(b.mesh) for b in scene.bodies if b.mesh is not None]
+    paths = [Path(scene.source)] + [Path(x.mesh) for x in scene.bodies + scene.surfaces
+                                    if getattr(x, "mesh", None) is not None]
     for path in paths:
         if path.is_file():
             h.update(path.read_bytes())

@@ -132,7 +132,7 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0):
               f"{len(model.frame_steps)} frames")
         for body in model.bodies:
             print(f"  ParaView series: {out_dir / (body.name + '.pvd')}")
-        for surface in (*model.plane_list, *model.surfaces.meshes):
+        for surface in model.surfaces.slots:
             print(f"  surface: {out_dir / (surface.name + '.pvd')}")
         print(f"  history: {out_dir / 'history.csv'}, summary: {out_dir / 'summary.json'}")
     return EXIT_OK
@@ -150,13 +150,8 @@ def _check(scene_path):
         mass = f"{b.mass:.6g} kg" if np.isfinite(b.mass) else "n/a (open mesh, not integrated)"
         print(f"  body {b.name!r}: {len(b.tributary_area)} contact points, {len(b.faces)} faces, "
               f"mass {mass}, motion {config.motion}")
-    for p in model.plane_list:
-        print(f"  plane {p.name!r}: point {p.point.tolist()}, normal {p.normal.tolist()}")
-    for m in model.surfaces.meshes:
-        moving = ("fixed" if m.static else
-                  f"turning at {m.rate:g} rad/s" if m.rate and not m.path.terms.size else "moving")
-        print(f"  mesh surface {m.name!r}: {len(m.vertices)} vertices, {len(m.faces)} faces, "
-              f"{moving}")
+    for surface, config in zip(model.surfaces.slots, _slot_configs(scene, model)):
+        print(f"  {_surface_summary(surface, config)}, {surface.describe()}")
     stable = (f"largest stable dt {limit:.3g} s" if np.isfinite(limit)
               else "no stability limit (quasi-static)" if model.quasi_static
               else "no stability limit (nothing integrated in time)")
@@ -182,6 +177,29 @@ def _check(scene_path):
           f"({per_step * 1e6:.3g} µs per step, {points / per_step:.3g} vertex-steps/s; "
           f"{active} of {total} vertices within reach of a surface)")
     return EXIT_OK
+
+
+def _slot_configs(scene, model):
+    """The scene's ``[[surface]]`` tables in the model's contact-slot order."""
+    by_name = {s.name: s for s in scene.surfaces}
+    return [by_name[s.name] for s in model.surfaces.slots]
+
+
+def _surface_summary(surface, config):
+    """``plane 'floor': point [..], normal [..]`` and the like."""
+    kind = config.type
+    if kind == "plane":
+        return (f"plane {surface.name!r}: point {list(config.point)}, "
+                f"normal {list(config.normal)}")
+    if kind == "mesh":
+        return (f"mesh surface {surface.name!r}: {len(surface.vertices)} vertices, "
+                f"{len(surface.faces)} faces")
+    if kind == "cylinder":
+        length = f"length {config.length:g} m" if config.length else "infinite"
+        return (f"cylinder {surface.name!r} ({config.side}): radius {config.radius:g} m, axis "
+                f"{list(config.axis)} through {list(config.point)}, {length}")
+    return (f"sphere {surface.name!r} ({config.side}): radius {config.radius:g} m, "
+            f"centre {list(config.center)}")
 
 
 def _info(mesh_path, units):

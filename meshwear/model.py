@@ -69,26 +69,21 @@ class BodyModel:
 
 
 @dataclass(frozen=True, eq=False)
-class PlaneModel:
-    name: str
-    point: np.ndarray
-    normal: np.ndarray
-    size: float
-
-
-@dataclass(frozen=True, eq=False)
 class Model:
     """Everything about a run that does not change while it runs.
 
-    ``planes`` is the (P, 3, 3) array the contact kernel takes (point, normal,
-    velocity per plane); ``law`` its (13,) contact and wear law. ``surfaces``
-    holds the planes and the mesh counter-surfaces (slots ``P + m`` of the
-    per-pair arrays); ``cull`` says whether bodies keep an active set.
+    ``surfaces`` (:class:`meshwear.surfaces.SurfaceSet`) holds the
+    counter-surfaces in contact-slot order: the uniform planes, whose rows
+    form ``planes``, the (P, 4, 3) array the contact kernel takes (point,
+    normal, velocity, angular velocity; moving planes are updated in place),
+    then the per-vertex ones (slots ``P + j``). ``law`` is the kernel's (13,)
+    contact and wear law; ``cull`` says whether bodies keep an active set;
+    ``extent`` (m) is the largest body's size, which unbounded surfaces are
+    drawn at.
     """
 
     scene: object
     bodies: tuple
-    plane_list: tuple
     planes: np.ndarray
     law: np.ndarray
     quasi_static: bool
@@ -101,6 +96,7 @@ class Model:
     cycle_steps: int = 0
     surfaces: object = None
     cull: bool = True
+    extent: float = 1.0
 
     def __post_init__(self):
         steps = np.union1d(np.union1d(self.sample_steps, self.frame_steps), [self.n_steps])
@@ -115,8 +111,8 @@ class Model:
 
     @property
     def slots(self):
-        """Number of counter-surfaces: planes, then meshes."""
-        return self.planes.shape[0] + (len(self.surfaces.meshes) if self.surfaces else 0)
+        """Number of counter-surfaces: planes, then the per-vertex ones."""
+        return self.planes.shape[0] + (len(self.surfaces.per_vertex) if self.surfaces else 0)
 
 
 @dataclass(eq=False)
@@ -139,7 +135,10 @@ class BodyState:
     wrench : (6,) float
         Contact force and torque about the centre of mass in the last step.
     vertex_planes : (M, n, 3, 3) float
-        Per mesh surface, the plane of the face under each active vertex.
+        Per per-vertex surface (analytic or mesh), the plane under each
+        active vertex.
+    hint : (M, n) int64
+        Per mesh surface, the face under each vertex at the last query (-1: none).
     active : (k,) int64
         The vertices within reach of a surface (:mod:`meshwear.surfaces`).
     active_wear : (k,) float
@@ -158,6 +157,7 @@ class BodyState:
     normal_force: np.ndarray
     wrench: np.ndarray = field(default_factory=lambda: np.zeros(6))
     vertex_planes: np.ndarray = None
+    hint: np.ndarray = None
     active: np.ndarray = None
     active_wear: np.ndarray = None
     cull: np.ndarray = None
@@ -185,24 +185,15 @@ def build_model(scene):
     SceneError, geometry.MeshError
         For input the engine cannot use, naming the key.
     """
-    # parts of format 1 that this version reads but cannot carry out yet are
-    # refused here, so no run silently does something other than asked
-    planes, meshes = [], []
+    built = []
     for j, s in enumerate(scene.surfaces):
-        if s.type == "mesh":
-            try:
-                meshes.append(surfaces.build_mesh_surface(s))
-            except geometry.MeshError as err:
-                key = f"surface[{j}].mesh" if s.mesh is not None else f"surface[{j}].shape"
-                raise SceneError(scene.source, key, str(err)) from None
-            continue
-        planes.append(PlaneModel(s.name, np.asarray(s.point, float),
-                                 np.asarray(s.normal, float), s.size))
-    plane_array = np.zeros((len(planes), 3, 3))
-    for j, p in enumerate(planes):
-        plane_array[j, 0] = p.point
-        plane_array[j, 1] = p.normal
-    surface_set = surfaces.SurfaceSet(plane_array, meshes)
+        try:
+            built.append(surfaces.build_surface(s))
+        except geometry.MeshError as err:
+            key = f"surface[{j}].mesh" if s.mesh is not None else f"surface[{j}].shape"
+            raise SceneError(scene.source, key, str(err)) from None
+    surface_set = surfaces.SurfaceSet(built)
+    plane_array = surface_set.planes
 
     run = scene.run
     n_steps = max(1, int(np.ceil(run.duration / run.dt - 1e-9)))
@@ -246,14 +237,18 @@ def build_model(scene):
                                  f"{list(config.path.free_axis)} (the load pulls it off every "
                                  "surface, or no surface faces it along that axis)")
         else:
-            _refuse_deep_start(scene, j, b, config, planes, meshes, vertex_planes)
+            _refuse_deep_start(scene, j, b, config, surface_set, vertex_planes)
+    # a turning mesh is static in shape if it is a surface of revolution
+    # about its axis, against the smallest active-set margin
+    margin = min(surfaces.margin_of(scene, b) for b in bodies)
+    for surface in surface_set.meshes:
+        surface.settle_invariance(margin)
+    surface_set.refresh_bounds()
     periods = _periods(scene)
     period = scene.wear.period or (max(periods) if periods else None)
-    # a plane without a size is drawn 4 body extents wide
-    extent = max(float(np.ptp(b.reference_vertices, axis=0).max()) for b in bodies)
-    planes = tuple(p if p.size is not None else PlaneModel(p.name, p.point, p.normal, 4.0 * extent)
-                   for p in planes)
-    return Model(scene=scene, bodies=bodies, plane_list=planes, planes=plane_array, law=law,
+    # unbounded surfaces (a plane without a size) are drawn 4 body extents wide
+    extent = 4.0 * max(float(np.ptp(b.reference_vertices, axis=0).max()) for b in bodies)
+    return Model(scene=scene, bodies=bodies, planes=plane_array, law=law, extent=extent,
                  surfaces=surface_set,
                  quasi_static=quasi_static, dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
                  frame_steps=_even_steps(n_steps, run.frames), period=period,
@@ -384,14 +379,16 @@ def _faces_to_refine(scene, body, vertices, faces, surface_set):
 START_PENETRATION = 0.01
 
 
-def _refuse_deep_start(scene, index, body, config, planes, meshes, vertex_planes):
+def _refuse_deep_start(scene, index, body, config, surface_set, vertex_planes):
     """A body placed deep inside a surface would be shot out by its first steps."""
     R = np.array(rotation_entries(body.initial_pose[3:7])).reshape(3, 3)
     x = body.initial_pose[0:3] + body.reference_vertices @ R.T
     allowed = START_PENETRATION * float(np.ptp(body.reference_vertices, axis=0).min())
-    depths = [(p, -float(((x - p.point) @ p.normal).min())) for p in planes]
+    depths = [(p, -float(((x - row[0]) @ row[1]).min()))
+              for p, row in zip(surface_set.uniform, surface_set.planes)]
+    # vertices with no plane under them (zero normal) are not inside
     depths += [(m, -float(np.einsum("ij,ij->i", x - vp[:, 0], vp[:, 1]).min()))
-               for m, vp in zip(meshes, vertex_planes)]
+               for m, vp in zip(surface_set.per_vertex, vertex_planes)]
     for p, depth in depths:
         if depth > allowed:
             raise SceneError(scene.source, f"body[{index}].position",
@@ -411,7 +408,7 @@ def point_coefficients(model, body):
 def initial_state(model):
     """Allocate the :class:`State` of ``model`` at t = 0, with each body's
     active set."""
-    S, M = model.slots, len(model.surfaces.meshes)
+    S, M = model.slots, len(model.surfaces.per_vertex)
     bodies = []
     for b in model.bodies:
         n = len(b.tributary_area)
@@ -420,9 +417,10 @@ def initial_state(model):
             wear_depth=np.zeros(n), friction_work=np.zeros(n), wear_volume=np.zeros(n),
             contact_state=np.zeros((S, n), dtype=np.int8),
             tangential=np.zeros((S, n, 4, 3)), normal_force=np.zeros((S, n)),
-            vertex_planes=np.zeros((M, n, 3, 3)), active=all_vertices(n), active_wear=np.zeros(n),
-            cull=np.zeros(surfaces.CULL_SIZE),
-            cull_scratch=surfaces.Cull(np.zeros(n), np.zeros((n, 3, 3)) if M else None)))
+            vertex_planes=np.zeros((M, n, 3, 3)), hint=np.full((M, n), -1, dtype=np.int64),
+            active=all_vertices(n), active_wear=np.zeros(n), cull=np.zeros(surfaces.CULL_SIZE),
+            cull_scratch=surfaces.Cull(np.zeros(n), np.zeros((n, 3, 3)) if M else None,
+                                       np.full(n, -1, dtype=np.int64))))
     state = State(time=0.0, step=0, bodies=bodies)
     for body, s in zip(model.bodies, state.bodies):
         surfaces.update(model, body, s, 0.0)

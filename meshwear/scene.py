@@ -32,14 +32,22 @@ WEAR_DIRECTIONS = ("contact_normal", "vertex_normal")
 ACCELERATIONS = ("none", "cycle_jump")
 UNITS = ("m", "mm", "cm", "um", "in")
 MOTIONS = ("free", "guided", "prescribed", "fixed")
-SURFACE_TYPES = ("plane", "mesh")
+SURFACE_TYPES = ("plane", "mesh", "cylinder", "sphere")
+SIDES = ("outside", "inside")
 #: keys of each primitive shape besides ``type``, and the required ones
 SHAPE_KEYS = {"box": ("size",), "sphere": ("radius", "subdivisions"),
               "cylinder": ("radius", "height", "sections")}
 SHAPE_REQUIRED = {"box": ("size",), "sphere": ("radius",), "cylinder": ("radius", "height")}
-PLANE_KEYS = ("point", "normal", "size")
-MESH_SURFACE_KEYS = ("mesh", "shape", "units", "resolution", "position", "orientation",
-                     "rotation", "path", "smooth_normals")
+#: keys of each ``[[surface]]`` type besides ``name`` and ``type``
+SURFACE_KEYS = {
+    "plane": ("point", "normal", "size", "rotation", "path"),
+    "mesh": ("mesh", "shape", "units", "resolution", "position", "orientation", "rotation",
+             "path", "smooth_normals"),
+    "cylinder": ("radius", "axis", "point", "length", "side", "rotation", "path"),
+    "sphere": ("radius", "center", "side", "rotation", "path"),
+}
+#: two directions closer than this (|a x b|) count as parallel
+PARALLEL = 1e-9
 
 
 def _check_mesh_or_shape(obj):
@@ -339,12 +347,18 @@ class BodyConfig:
 
 @dataclass(frozen=True, kw_only=True)
 class SurfaceConfig:
-    """``[[surface]]``: a counter-surface (does not wear).
+    """``[[surface]]``: a counter-surface (does not wear). Every type takes an
+    optional steady ``rotation`` and a ``path`` (without free_axis).
 
     ``type = "plane"``: ``point``, unit ``normal`` (pointing into the bodies) and
-    an optional ``size`` (m, side of the patch drawn in ParaView).
+    an optional ``size`` (m, side of the patch drawn in ParaView); it turns
+    about its normal only.
+    ``type = "cylinder"``: ``radius`` (m), unit ``axis``, ``point`` on the axis,
+    optional ``length`` (m, centred on ``point``; infinite without it) and
+    ``side`` ("outside": a shaft or ring, "inside": a bore).
+    ``type = "sphere"``: ``radius``, ``center`` and ``side`` (a ball, or a cup).
     ``type = "mesh"``: mesh or shape, units, resolution, position, orientation as
-    for a body, plus an optional ``rotation`` and ``path`` (without free_axis).
+    for a body, and ``smooth_normals``.
     """
 
     name: str
@@ -352,6 +366,11 @@ class SurfaceConfig:
     point: tuple = (0.0, 0.0, 0.0)
     normal: tuple = (0.0, 0.0, 1.0)
     size: float | None = None
+    radius: float | None = None
+    axis: tuple | None = None
+    length: float | None = None
+    side: str = "outside"
+    center: tuple = (0.0, 0.0, 0.0)
     mesh: Path | None = None
     shape: ShapeConfig | None = None
     units: str = "m"
@@ -367,21 +386,49 @@ class SurfaceConfig:
         _set(self, "name", _name)
         _set(self, "type", _choice, SURFACE_TYPES)
         _set(self, "smooth_normals", _boolean)
-        if self.type == "plane":
-            _set(self, "point", _vector)
-            _set(self, "normal", _direction)
-            _set_optional(self, "size", _positive)
-            for key in ("mesh", "shape", "resolution", "rotation", "path"):
-                if getattr(self, key) is not None:
-                    raise SceneError("", key, 'applies to type = "mesh" surfaces only')
-            return
-        if self.size is not None:
-            raise SceneError("", "size", 'applies to type = "plane" surfaces only')
-        _check_mesh_or_shape(self)
         _set_optional(self, "rotation", _instance, RotationConfig)
+        _set_optional(self, "path", _instance, PathConfig)
         if self.path is not None and self.path.free_axis is not None:
             raise SceneError("", "path.free_axis", "applies to guided bodies only; "
                                                    "a surface follows its path exactly")
+        own = set(SURFACE_KEYS[self.type])
+        defaults = {f.name: f.default for f in dataclasses.fields(self)}
+        for key in {k for keys in SURFACE_KEYS.values() for k in keys} - own:
+            if getattr(self, key) != defaults[key]:
+                raise SceneError("", key, f'does not apply to a type = "{self.type}" surface')
+        if self.type == "mesh":
+            _check_mesh_or_shape(self)
+            return
+        _set(self, "point", _vector)
+        _set(self, "center", _vector)
+        turn = None if self.rotation is None or self.rotation.rate == 0.0 else self.rotation.axis
+        if self.type == "plane":
+            _set(self, "normal", _direction)
+            _set_optional(self, "size", _positive)
+            if turn is not None and _cross_norm(turn, self.normal) > PARALLEL:
+                raise SceneError("", "rotation.axis", f"{_show(turn)}: a plane turns about its "
+                                 f"normal {_show(self.normal)} only (a turning disc)")
+            return
+        if self.radius is None:
+            raise SceneError("", "radius", f"missing; a {self.type} needs a radius (m)")
+        _set(self, "radius", _positive)
+        _set(self, "side", _choice, SIDES)
+        if self.type == "cylinder":
+            if self.axis is None:
+                raise SceneError("", "axis", "missing; a cylinder needs the direction of its axis")
+            _set(self, "axis", _direction)
+            _set_optional(self, "length", _positive)
+            if (turn is not None and self.length is None
+                    and _cross_norm(turn, self.axis) > PARALLEL):
+                raise SceneError("", "rotation.axis", f"{_show(turn)}: an infinite cylinder "
+                                 f"turns only about an axis parallel to its own "
+                                 f"{_show(self.axis)}; give it a length to tumble it")
+
+
+def _cross_norm(a, b):
+    """|a x b| of two unit vectors (0 when parallel)."""
+    return math.hypot(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                      a[0] * b[1] - a[1] * b[0])
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -639,9 +686,10 @@ def _body(source, base_dir, value, prefix):
 
 def _surface(source, base_dir, value, prefix):
     kind = _typed(source, value, prefix, SURFACE_TYPES, default="plane")
-    own, other = (PLANE_KEYS, MESH_SURFACE_KEYS) if kind == "plane" else (MESH_SURFACE_KEYS, PLANE_KEYS)
+    own = SURFACE_KEYS[kind]
+    other = {k for keys in SURFACE_KEYS.values() for k in keys} - set(own)
     table = _table(source, value, prefix, SurfaceConfig, ("name", "type") + own, other,
-                   f'a type = "{kind}" surface')
+                   f'a type = "{kind}" surface (its keys: {", ".join(own)})')
     table = _geometry(source, base_dir, table, prefix)
     if "rotation" in table:
         table["rotation"] = _simple(RotationConfig, table["rotation"], f"{prefix}.rotation", source)

@@ -53,10 +53,13 @@ def contact(body_vertices, pose, planes, vertex_planes, active, area_vectors, la
     moves = np.zeros_like(x)
     is_active = np.zeros(count, bool)
     is_active[active] = True
-    slots = [np.broadcast_to(pl, (count, 3, 3)) for pl in planes] + list(vertex_planes)
+    slots = [np.broadcast_to(pl, (count, 4, 3)) for pl in planes] + list(vertex_planes)
     for s, pl in enumerate(slots):
         p, n, vel = pl[:, 0], pl[:, 1], pl[:, 2]
         delta = _dot(x - p, n)
+        if s < len(planes):
+            # a plane turning about its point: omega x (foot - point)
+            vel = vel + np.cross(pl[:, 3], x - delta[:, None] * n - p)
         area = contact_areas(area_vectors, R, n)
         touching = is_active & (delta < 0.0) & (area > FACING * area_vectors[:, 3])
         c, d, ct, dtan = point_coefficients(area, law)
@@ -192,7 +195,7 @@ def balance_offset(body_vertices, pose, axis, planes, vertex_planes, active, are
     x = pose[0:3] + body_vertices[active] @ R.T
     av = area_vectors[active]
     zs, ws, signs = [], [], []
-    slots = [np.broadcast_to(pl, (len(active), 3, 3)) for pl in planes]
+    slots = [np.broadcast_to(pl[:3], (len(active), 3, 3)) for pl in planes]
     slots += [vp[active] for vp in vertex_planes]
     for pl in slots:
         p, n = pl[:, 0], pl[:, 1]
@@ -261,7 +264,8 @@ def closest_points(tri, points):
 
 
 def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-                   face_normals, corner_normals, reach, out, distance, tracking=0.5, tie=1e-9):
+                   face_normals, corner_normals, reach, out, distance, hint, tracking=0.5,
+                   tie=1e-9):
     """Same contract as :func:`meshwear.kernels.nearest.nearest_planes`, by
     brute force over every face (no grid)."""
     R = quaternion_matrix(pose[3:7])
@@ -290,9 +294,14 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
         foot = points - delta[:, None] * face_normals
         lateral = np.linalg.norm(closest_points(tri, foot)[0] - foot, axis=1)
         over = lateral <= 1e-9 * reach
-        kept = pick(within & over & (face_normals @ prev >= tracking)) \
-            if tracked else -1
+        eligible = within & over & (face_normals @ prev >= tracking)
+        h = hint[i]
+        if tracked and h >= 0 and eligible[h]:
+            kept = h                  # still over the face it had: it stays there
+        else:
+            kept = pick(eligible) if tracked else -1
         best = kept if kept >= 0 else pick(within)
+        hint[i] = best
         if best < 0:
             out[i] = 0.0
             distance[i] = np.inf
@@ -309,3 +318,57 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
         out[i, 0] = p
         out[i, 1] = rotation @ normal
         out[i, 2] = motion[1] + np.cross(motion[2], p - motion[3])
+
+
+# ---------------------------------------------------------------- counter-surfaces
+
+def turn_matrix(axis, angle):
+    """Rotation by ``angle`` about unit ``axis`` (matrix exponential form)."""
+    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * (K @ K)
+
+
+def surface_frame(motion, terms, t, frozen):
+    """Same contract as :func:`meshwear.kernels.frames.surface_frame`:
+    returns (rotation, frame)."""
+    R0, position = motion[0:9].reshape(3, 3), motion[9:12]
+    axis, rate, center = motion[12:15], motion[15], motion[16:19]
+    shift, velocity = path_point(terms, t)
+    turn = turn_matrix(axis, 0.0 if frozen else rate * t)
+    frame = np.array([turn @ (position - center) + center + shift, velocity, rate * axis,
+                      center + shift])
+    return turn @ R0, frame
+
+
+def _surface_planes(points, normals, frame, gap, ok, active, out, distance):
+    velocity = frame[1] + np.cross(frame[2], points - frame[3])
+    rows = np.stack([points, normals, velocity], axis=1)
+    out[active] = np.where(ok[:, None, None], rows, 0.0)
+    distance[active] = np.where(ok, gap, np.inf)
+
+
+def cylinder_planes(body_vertices, pose, active, rotation, frame, geometry, out, distance):
+    """Same contract as :func:`meshwear.kernels.analytic.cylinder_planes_serial`."""
+    radius, half, sign = geometry[0], geometry[1], 1.0 - 2.0 * geometry[2]
+    x = pose[0:3] + body_vertices[active] @ quaternion_matrix(pose[3:7]).T
+    y = (x - frame[0]) @ rotation
+    r = np.hypot(y[:, 0], y[:, 1])
+    ok = (np.abs(y[:, 2]) <= half) & (r > 0.0)
+    u = np.zeros_like(y)
+    u[:, 0:2] = y[:, 0:2] / np.where(ok, r, 1.0)[:, None]
+    closest = radius * u
+    closest[:, 2] = y[:, 2]
+    _surface_planes(closest @ rotation.T + frame[0], sign * u @ rotation.T, frame,
+                    sign * (r - radius), ok, active, out, distance)
+
+
+def sphere_planes(body_vertices, pose, active, rotation, frame, geometry, out, distance):
+    """Same contract as :func:`meshwear.kernels.analytic.sphere_planes_serial`."""
+    radius, sign = geometry[0], 1.0 - 2.0 * geometry[1]
+    x = pose[0:3] + body_vertices[active] @ quaternion_matrix(pose[3:7]).T
+    e = x - frame[0]
+    r = np.linalg.norm(e, axis=1)
+    ok = r > 0.0
+    u = e / np.where(ok, r, 1.0)[:, None]
+    _surface_planes(frame[0] + radius * u, sign * u, frame, sign * (r - radius), ok, active,
+                    out, distance)

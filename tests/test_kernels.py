@@ -18,12 +18,13 @@ def _random_case(rng, n, n_planes, wear_law, along_vertex_normal):
     pose[3:7] = q / np.linalg.norm(q)
     pose[7:10] = rng.normal(scale=0.05, size=3)
     pose[10:13] = rng.normal(scale=2.0, size=3)
-    planes = np.zeros((n_planes, 3, 3))
+    planes = np.zeros((n_planes, 4, 3))
     for s in range(n_planes):
         normal = np.array([0.0, 0.0, 1.0]) + rng.normal(scale=0.3, size=3)
         planes[s, 1] = normal / np.linalg.norm(normal)
         planes[s, 0] = rng.normal(scale=0.002, size=3)
         planes[s, 2] = rng.normal(scale=0.01, size=3)
+        planes[s, 3] = rng.normal(scale=5.0) * planes[s, 1]   # turning about its normal
     # area vectors: mostly facing the planes (-z), some sideways or away
     directions = rng.normal(size=(n, 3)) + [0.0, 0.0, -1.5]
     params = np.zeros((n, 4))
@@ -102,7 +103,7 @@ def test_mesh_slots_and_active_set_match_numpy_twin(kernel):
     n = 300
     vertices, pose, planes, params, law, direction, arrays = _random_case(
         rng, n, 3, contact.ARCHARD, False)
-    vertex_planes = np.repeat(planes[1:, None], n, axis=1).copy()
+    vertex_planes = np.repeat(planes[1:, None, :3], n, axis=1).copy()
     tilt = vertex_planes[:, :, 1] + rng.normal(scale=0.05, size=(2, n, 3))
     vertex_planes[:, :, 1] = tilt / np.linalg.norm(tilt, axis=2)[:, :, None]
     vertex_planes[:, :, 2] += rng.normal(scale=0.02, size=(2, n, 3))
@@ -135,7 +136,7 @@ def test_a_sticking_anchor_moves_with_its_counter_surface():
     pose = np.zeros(13)
     pose[3] = 1.0
     pose[2] = -1e-6
-    planes = np.zeros((1, 3, 3))
+    planes = np.zeros((1, 4, 3))
     planes[0, 1, 2] = 1.0
     planes[0, 2, 0] = 0.2  # the plane moves at 0.2 m/s along x
     law = contact.make_law(friction=0.5, static_friction=0.5, wear_law="energy",
@@ -159,7 +160,7 @@ def test_contact_state_machine_transitions():
     pose = np.zeros(13)
     pose[3] = 1.0
     pose[2] = -1e-6  # 1 µm penetration
-    planes = np.zeros((1, 3, 3))
+    planes = np.zeros((1, 4, 3))
     planes[0, 1, 2] = 1.0
     c = 1e6
     params = FACING_DOWN
@@ -264,7 +265,7 @@ def test_reversal_exactly_on_a_step_starts_stick_despite_a_dip_in_load():
     pose = np.zeros(13)
     pose[3] = 1.0
     pose[2] = -1e-6
-    planes = np.zeros((1, 3, 3))
+    planes = np.zeros((1, 4, 3))
     planes[0, 1, 2] = 1.0
     c = 1e6
     law = contact.make_law(friction=0.3, static_friction=0.3, wear_law="energy",
@@ -322,7 +323,7 @@ def test_balance_offset_matches_numpy_twin(load, opposed):
     axis /= np.linalg.norm(axis)
     # the second plane as a mesh surface would give it: one plane per vertex,
     # tilted a little differently under each; every third vertex inactive
-    vertex_planes = np.repeat(planes[1:2, None], 300, axis=1).copy()
+    vertex_planes = np.repeat(planes[1:2, None, :3], 300, axis=1).copy()
     tilt = vertex_planes[0, :, 1] + rng.normal(scale=0.02, size=(300, 3))
     vertex_planes[0, :, 1] = tilt / np.linalg.norm(tilt, axis=1)[:, None]
     planes = planes[:1]
@@ -358,7 +359,7 @@ def test_balance_offset_refuses_a_load_nothing_can_carry():
     vertices = np.array([[0.0, 0.0, 0.0]])
     pose = np.zeros(13)
     pose[3] = 1.0
-    planes = np.zeros((1, 3, 3))
+    planes = np.zeros((1, 4, 3))
     planes[0, 1, 2] = 1.0
     law = contact.make_law(friction=0.3, static_friction=0.3, wear_law="energy",
                            wear_coefficient=0.0, dt=1e-5, stiffness=1e6)
@@ -384,7 +385,7 @@ def test_a_reversal_step_longer_than_the_unloading_slips_again_at_once():
     pose = np.zeros(13)
     pose[3] = 1.0
     pose[2] = -1e-6
-    planes = np.zeros((1, 3, 3))
+    planes = np.zeros((1, 4, 3))
     planes[0, 1, 2] = 1.0
     c = 1e6
     law = contact.make_law(friction=0.5, static_friction=0.5, wear_law="energy",

@@ -70,16 +70,32 @@ def test_nearest_planes_match_brute_force_twin(smooth):
     guess = directions @ rotation.T + rng.normal(scale=0.4, size=(n, 3))
     out[tracked, 1] = (guess / np.linalg.norm(guess, axis=1)[:, None])[tracked]
     twin_out, distance, twin_distance = out.copy(), np.full(n, -1.0), np.full(n, -1.0)
-    nearest.nearest_planes(body, pose, active, rotation, motion, V, F,
-                           nearest.face_frames(V, F), vnormals, *grid, out, distance)
+    hint, twin_hint = np.full(n, -1), np.full(n, -1)
+    frames = nearest.face_frames(V, F)
+    nearest.nearest_planes(body, pose, active, rotation, motion, V, F, frames, vnormals, *grid,
+                           out, distance, hint)
     reference.nearest_planes(body, pose, active, rotation, motion, V, F, normals, vnormals, reach,
-                             twin_out, twin_distance)
+                             twin_out, twin_distance, twin_hint)
     assert _close(out, twin_out)
     assert _close(distance, twin_distance)
+    assert (hint == twin_hint).all()
     found = np.isfinite(distance[active])
     assert 0.3 < found.mean() < 1.0, "the case must have vertices in and out of reach"
     inactive = np.setdiff1d(np.arange(n), active)
     assert (distance[inactive] == -1.0).all()
+    # the next step, the body moved a little: each vertex starts from the
+    # face it had (a third of them from a wrong one), kept while it is over it
+    pose[0:3] += [3e-4, -2e-4, 1e-4]
+    stale = rng.random(n) < 0.3
+    hint[stale] = rng.integers(0, len(F), stale.sum())
+    twin_hint = hint.copy()
+    nearest.nearest_planes(body, pose, active, rotation, motion, V, F, frames, vnormals, *grid,
+                           out, distance, hint)
+    reference.nearest_planes(body, pose, active, rotation, motion, V, F, normals, vnormals, reach,
+                             twin_out, twin_distance, twin_hint)
+    assert _close(out, twin_out)
+    assert _close(distance, twin_distance)
+    assert (hint == twin_hint).all()
 
 
 def test_grid_cells_list_every_face_within_reach():
@@ -591,11 +607,12 @@ def test_the_collision_manager_names_the_mesh_surfaces_a_body_comes_near(tmp_pat
     model = build_model(load_scene(path))
     body = model.bodies[0]
     pose = body.initial_pose
-    names = [m.name for m in model.surfaces.meshes]
-    near = model.surfaces.meshes_within
-    assert [names[j] for j in near(body, pose, 0.0, 1e-4)] == ["floor"]
-    assert [names[j] for j in near(body, pose, 0.0, 3e-4)] == ["floor", "beside"]
-    assert len(near(body, pose, 0.0, 1.0)) == 3
+    def near(margin):
+        return [m.name for m in model.surfaces.meshes_within(body, pose, 0.0, margin)]
+
+    assert near(1e-4) == ["floor"]
+    assert near(3e-4) == ["floor", "beside"]
+    assert len(near(1.0)) == 3
 
 
 @pytest.mark.parametrize("name", ["cad_part", "pin_on_turning_disc"])

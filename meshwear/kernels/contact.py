@@ -13,9 +13,11 @@ pose : (13,)
     Rigid state of the body: centre of mass ``x`` (0:3, m, world), unit
     quaternion ``q`` (3:7, w x y z, body -> world), velocity ``v`` of the centre
     of mass (7:10, m/s, world), angular velocity ``omega`` (10:13, rad/s, world).
-planes : (P, 3, 3)
+planes : (P, 4, 3)
     Per plane: a point on it (m), its unit normal ``n`` pointing into the worn
-    body, and its translational velocity (m/s).
+    body, its translational velocity (m/s) and its angular velocity (rad/s,
+    along ``n``: a turning disc) about that point. The surface velocity under
+    a vertex is ``v + omega x (a - point)``, ``a`` the vertex's foot.
 vertex_planes : (M, n, 3, 3)
     Per mesh counter-surface and vertex, the same for the plane of the
     counter face under the vertex, the velocity being the counter-surface's at
@@ -169,8 +171,19 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
                 for j in range(3):
                     tangential[s, i, FORCE, j] = 0.0
                 continue
-            # velocity of A relative to the plane: normal rate and slip velocity
-            gx, gy, gz = ux - plane[2, 0], uy - plane[2, 1], uz - plane[2, 2]
+            # point of the plane under A
+            ax, ay, az = px - delta * nx, py - delta * ny, pz - delta * nz
+            # the counter-surface's velocity there: a plane's translation plus
+            # its turn about its point; a mesh or analytic surface's, as given
+            svx, svy, svz = plane[2, 0], plane[2, 1], plane[2, 2]
+            if s < n_planes:
+                ox, oy, oz = plane[3, 0], plane[3, 1], plane[3, 2]
+                kx, ky, kz = ax - plane[0, 0], ay - plane[0, 1], az - plane[0, 2]
+                svx += oy * kz - oz * ky
+                svy += oz * kx - ox * kz
+                svz += ox * ky - oy * kx
+            # velocity of A relative to the surface: normal rate and slip velocity
+            gx, gy, gz = ux - svx, uy - svy, uz - svz
             rate = gx * nx + gy * ny + gz * nz
             sx, sy, sz = gx - rate * nx, gy - rate * ny, gz - rate * nz
             c, d, ct, dtan = c0 + c1 * a, d0 + d1 * a, ct0 + ct1 * a, dt0 + dt1 * a
@@ -179,8 +192,6 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
             if load < 0.0:
                 load = 0.0
             normal_force[s, i] = load
-            # point of the plane under A
-            ax, ay, az = px - delta * nx, py - delta * ny, pz - delta * nz
             state = contact_state[s, i]
             reversed_now = False
             # friction state of the pair (tangential[s, i]): stick anchor o,
@@ -188,8 +199,9 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
             # read and written only where the state machine needs them
             if state == STICK:
                 # the anchor is a point of the counter-surface: it moves with it
-                for j in range(3):
-                    tangential[s, i, ANCHOR, j] += plane[2, j] * dt
+                tangential[s, i, ANCHOR, 0] += svx * dt
+                tangential[s, i, ANCHOR, 1] += svy * dt
+                tangential[s, i, ANCHOR, 2] += svz * dt
             elif state == NO_CONTACT:
                 # a new contact starts in stick with F0 = 0 at its position
                 state = STICK

@@ -122,7 +122,7 @@ def _along(frames, f, row, x, y, z):
 
 
 def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-                    frames, corner_normals, grid, keys, starts, items, out, distance):
+                    frames, corner_normals, grid, keys, starts, items, out, distance, hint):
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
     smooth = corner_normals.shape[0] > 0
     reach2 = grid[7] * grid[7]
@@ -146,13 +146,25 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
         tx = rotation[0, 0] * ox + rotation[1, 0] * oy + rotation[2, 0] * oz
         ty = rotation[0, 1] * ox + rotation[1, 1] * oy + rotation[2, 1] * oz
         tz = rotation[0, 2] * ox + rotation[1, 2] * oy + rotation[2, 2] * oz
-        lo, hi = _cell_range(yx, yy, yz, grid, keys, starts)
         # the nearest face, and the nearest of the faces the vertex can stay
         # on (within TRACKING of its last normal, and with the vertex over
         # it, not beyond its edges: past a convex edge the vertex lets go)
         best = kept = -1
         best_d2 = kept_d2 = np.inf
         best_delta = kept_delta = -np.inf
+        lo, hi = _cell_range(yx, yy, yz, grid, keys, starts)
+        h = hint[i]
+        if tracked and h >= 0:
+            # still over the face it had, within reach and TRACKING: it stays
+            # there, no scan (the scan would pick it too, unless the vertex
+            # is over two such faces at once, at a concave fold)
+            delta = _along(frames, h, 0, yx, yy, yz)
+            outside = max(_along(frames, h, 1, yx, yy, yz), _along(frames, h, 2, yx, yy, yz),
+                          _along(frames, h, 3, yx, yy, yz))
+            if (delta * delta <= reach2 and outside <= over
+                    and _along(frames, h, 0, tx, ty, tz) + frames[h, 0, 3] >= TRACKING):
+                kept, kept_d2, kept_delta = h, delta * delta, delta
+                lo = hi
         for j in range(lo, hi):
             f = items[j]
             delta = _along(frames, f, 0, yx, yy, yz)
@@ -189,6 +201,7 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
                     kept, kept_d2, kept_delta = f, d2, delta
         if kept >= 0:
             best, best_d2, best_delta = kept, kept_d2, kept_delta
+        hint[i] = best
         if best < 0:
             for row in range(3):
                 for col in range(3):
@@ -260,18 +273,19 @@ PARALLEL_THRESHOLD = 2048
 
 
 def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-                   frames, corner_normals, grid, keys, starts, items, out, distance):
+                   frames, corner_normals, grid, keys, starts, items, out, distance, hint):
     """For each ``active`` vertex ``i`` of a body at ``pose``, write to
     ``out[i]`` (3, 3) the plane of its nearest counter face within the grid's
-    reach (``grid[7]``) (point, normal, counter velocity there; world) and to
-    ``distance[i]`` the distance to that face; zeros and ``inf`` where no
-    face qualifies. A vertex that had a plane (``out[i]`` nonzero on entry)
-    keeps to faces whose normal is within 60 degrees of the one it had while
-    it is over one of them (:data:`TRACKING`)."""
+    reach (``grid[7]``) (point, normal, counter velocity there; world), to
+    ``distance[i]`` the distance to that face and to ``hint[i]`` (int64) the
+    face's index; zeros, ``inf`` and -1 where no face qualifies. A vertex that
+    had a plane (``out[i]`` nonzero on entry) keeps to faces whose normal is
+    within 60 degrees of the one it had while it is over one of them
+    (:data:`TRACKING`), and to face ``hint[i]`` itself while it is over it."""
     kernel = (nearest_planes_parallel if active.shape[0] >= PARALLEL_THRESHOLD
               else nearest_planes_serial)
     kernel(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-           frames, corner_normals, grid, keys, starts, items, out, distance)
+           frames, corner_normals, grid, keys, starts, items, out, distance, hint)
 
 
 #: faces meeting at a vertex at more than 60 degrees are a crease: smoothed

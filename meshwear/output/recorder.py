@@ -9,7 +9,7 @@ from pathlib import Path
 from ..wear import error_estimate
 from .fields import body_quantities
 from .tables import HISTORY_COLUMNS, HistoryWriter, write_json_atomic
-from .vtk import PVDSeries, plane_patch
+from .vtk import PVDSeries
 
 #: columns added to DESIGN.md §5's history.csv (extend, never rename)
 EXTRA_COLUMNS = ("wx", "wy", "wz", "tx", "ty", "tz", "contact_points", "stick_points", "slip_points")
@@ -34,21 +34,18 @@ class RunRecorder:
         self.series = {b.name: PVDSeries(self.out_dir, b.name, b.faces, resume_until)
                        for b in model.bodies}
         self.history = HistoryWriter(self.out_dir / "history.csv", EXTRA_COLUMNS, resume_until)
-        for plane in model.plane_list:
-            vertices, faces = plane_patch(plane.point, plane.normal, plane.size)
-            patch = PVDSeries(self.out_dir, plane.name, faces)
-            patch.write_frame(0.0, vertices, {})
-            patch.close()
-        # mesh counter-surfaces: one frame if they stay put, else one per frame
+        # counter-surfaces: one frame if they stay put, else one per frame
         self.moving = {}
-        for mesh in model.surfaces.meshes:
-            if mesh.static:
-                still = PVDSeries(self.out_dir, mesh.name, mesh.faces)
-                still.write_frame(0.0, mesh.world_vertices(0.0), {})
+        for surface in model.surfaces.slots:
+            vertices, faces = surface.drawing(model.extent)
+            if surface.static:
+                still = PVDSeries(self.out_dir, surface.name, faces)
+                still.write_frame(0.0, surface.world_vertices(vertices, 0.0), {})
                 still.close()
             else:
-                self.moving[mesh.name] = (mesh, PVDSeries(self.out_dir, mesh.name, mesh.faces,
-                                                          resume_until))
+                self.moving[surface.name] = (surface, vertices,
+                                             PVDSeries(self.out_dir, surface.name, faces,
+                                                       resume_until))
 
     def on_sample(self, model, state):
         for body, s in zip(model.bodies, state.bodies):
@@ -69,14 +66,14 @@ class RunRecorder:
         for body, s in zip(model.bodies, state.bodies):
             q = body_quantities(body, s, model)
             self.series[body.name].write_frame(state.time, q["points"], {k: q[k] for k in FIELDS})
-        for mesh, series in self.moving.values():
-            series.write_frame(state.time, mesh.world_vertices(state.time), {})
+        for surface, vertices, series in self.moving.values():
+            series.write_frame(state.time, surface.world_vertices(vertices, state.time), {})
 
     def close(self, summary):
         self.history.close()
         for series in self.series.values():
             series.close()
-        for _, series in self.moving.values():
+        for _, _, series in self.moving.values():
             series.close()
         write_json_atomic(self.out_dir / "summary.json", summary)
 

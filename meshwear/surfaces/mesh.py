@@ -1,0 +1,182 @@
+"""Mesh counter-surfaces: a rigid triangle mesh, its face grid and its fcl BVH.
+
+Each vertex of a worn body gets the plane of its nearest counter face
+(:mod:`meshwear.kernels.nearest`). A mesh turning about an axis that it is a
+surface of revolution about (a ring, a disc, a shaft, within the sagitta of
+its facets) counts as static in shape: its deviation from that surface,
+measured when the run is built, is checked against the active-set margin.
+"""
+
+import fcl
+import numpy as np
+
+from .. import geometry
+from ..kernels.counter import MESH
+from ..kernels.nearest import (build_grid, corner_normals, face_frames, nearest_planes_parallel,
+                               nearest_planes_serial)
+from .base import CounterSurface, SurfaceMotion, axis_rotation, quaternion_matrix
+
+#: a turning mesh is static in shape when its deviation from a surface of
+#: revolution about the turn's axis is at most this fraction of the smallest
+#: active-set margin (the rest of the margin is left for the bodies' motion)
+INVARIANT_FRACTION = 0.25
+#: turns (fractions of a revolution) at which the deviation is sampled: far
+#: from the n-fold symmetries of a meshed ring (golden-ratio multiples)
+SAMPLE_TURNS = (0.145898, 0.381966, 0.618034, 0.854102)
+#: the deviation is sampled at most at this many points (vertices, face centres)
+MAX_SAMPLES = 200_000
+
+
+def bvh(vertices, faces):
+    """An fcl BVH of a triangle mesh."""
+    model = fcl.BVHModel()
+    model.beginModel(len(vertices), len(faces))
+    model.addSubModel(vertices, faces)
+    model.endModel()
+    return model
+
+
+class MeshSurface(CounterSurface):
+    """A rigid counter mesh: its faces in its own frame, placed by
+    ``orientation`` (quaternion) and ``position`` and moved by ``rotation`` and
+    ``path`` (:class:`meshwear.surfaces.base.SurfaceMotion`)."""
+
+    kind = MESH
+
+    def __init__(self, name, vertices, faces, position, orientation, rotation=None, path=None,
+                 smooth_normals=False):
+        super().__init__(name, SurfaceMotion(quaternion_matrix(orientation), position, rotation,
+                                             path))
+        self.vertices, self.faces = geometry._arrays(vertices, faces)
+        self.face_normals = np.ascontiguousarray(geometry.face_normals(self.vertices, self.faces))
+        self.frames = face_frames(self.vertices, self.faces)
+        self.corner_normals = (corner_normals(self.vertices, self.faces, self.face_normals)
+                               if smooth_normals else np.zeros((0, 3, 3)))
+        m = self.motion
+        world = self.vertices @ m.R0.T + m.position - m.center
+        #: largest distance of a mesh point from the turn's axis (m)
+        self.lever = float(np.linalg.norm(world - np.outer(world @ m.axis, m.axis), axis=1).max())
+        self.reach = 0.0
+        self.grid = None
+        self.bvh_geometry = bvh(self.vertices, self.faces)
+        self.bvh = fcl.CollisionObject(self.bvh_geometry, fcl.Transform())
+
+    @classmethod
+    def from_config(cls, config):
+        """A :class:`MeshSurface` from a validated ``[[surface]]`` of type mesh.
+
+        Raises
+        ------
+        geometry.MeshError
+            For a mesh the engine cannot use; the caller adds the key.
+        """
+        if config.mesh is not None:
+            vertices, faces = geometry.load_mesh(config.mesh, config.units)
+        else:
+            s = config.shape
+            vertices, faces = geometry.primitive(s.type, size=s.size, radius=s.radius,
+                                                 subdivisions=s.subdivisions, height=s.height,
+                                                 sections=s.sections)
+        if config.resolution is not None:
+            vertices, faces = geometry.refine(vertices, faces, config.resolution)
+        return cls(config.name, vertices, faces, config.position, config.orientation,
+                   config.rotation, config.path, config.smooth_normals)
+
+    # ------------------------------------------------------------ shape invariance
+    def settle_invariance(self, margin):
+        """Decide whether its turn leaves its shape unchanged, against the
+        smallest active-set ``margin`` (m): its deviation from a surface of
+        revolution about the turn's axis at most :data:`INVARIANT_FRACTION`
+        of it."""
+        if self.motion.rate == 0.0:
+            return
+        limit = INVARIANT_FRACTION * margin
+        deviation = self.revolution_deviation(limit)
+        self.invariant = deviation <= limit
+        self.deviation = deviation if self.invariant else 0.0
+        self._compiled = None
+
+    def revolution_deviation(self, limit):
+        """Largest distance (m) of the mesh turned about its turn's axis from
+        the mesh itself, sampled at its vertices and face centres at
+        :data:`SAMPLE_TURNS`; ``inf`` if it exceeds ``limit`` (m)."""
+        m = self.motion
+        axis = m.R0.T @ m.axis                      # the turn's axis in the mesh frame
+        center = m.R0.T @ (m.center - m.position)
+        samples = np.concatenate([self.vertices, self.vertices[self.faces].mean(axis=1)])
+        if len(samples) > MAX_SAMPLES:
+            pick = np.random.default_rng(0).choice(len(samples), MAX_SAMPLES, replace=False)
+            samples = samples[np.sort(pick)]
+        grid, keys, starts, items = build_grid(self.vertices, self.faces, self.face_normals, limit)
+        n = len(samples)
+        identity = np.zeros(13)
+        identity[3] = 1.0
+        active = np.arange(n, dtype=np.int64)
+        worst = 0.0
+        kernel = nearest_planes_parallel if n >= 2048 else nearest_planes_serial
+        for turn in SAMPLE_TURNS:
+            turn_matrix = axis_rotation(axis, 2.0 * np.pi * turn)
+            turned = np.ascontiguousarray((samples - center) @ turn_matrix.T + center)
+            out, distance = np.zeros((n, 3, 3)), np.full(n, np.inf)
+            kernel(turned, identity, active, np.eye(3), np.zeros((4, 3)), self.vertices,
+                   self.faces, self.frames, self.corner_normals, grid, keys, starts, items, out,
+                   distance, np.full(n, -1))
+            worst = max(worst, float(distance.max()))
+            if not worst <= limit:
+                return np.inf
+        return worst
+
+    # ------------------------------------------------------------ the interface
+    def ensure_reach(self, reach):
+        """(Re)bin the faces if queries must find faces ``reach`` (m) away."""
+        if reach > self.reach:
+            self.reach = 1.5 * reach
+            self.grid = build_grid(self.vertices, self.faces, self.face_normals, self.reach)
+            self._compiled = None
+
+    def geometry(self):
+        if self.grid is None:
+            raise RuntimeError(f"mesh surface {self.name!r}: no face grid yet (ensure_reach)")
+        grid, keys, starts, items = self.grid
+        return {"geometry": np.zeros(3), "counter_vertices": self.vertices, "faces": self.faces,
+                "frames": self.frames, "corner_normals": self.corner_normals, "grid": grid,
+                "keys": keys, "starts": starts, "items": items}
+
+    def bounds(self):
+        if self.invariant:
+            # its turn moves its shape by at most the deviation, whenever
+            return self._bounds(constant=2.0 * self.deviation)
+        return self._bounds(lever=self.lever)
+
+    def planes_at(self, body_vertices, pose, t, reach):
+        saved = self.grid, self.reach, self._compiled
+        self.grid, self._compiled = build_grid(self.vertices, self.faces, self.face_normals,
+                                               reach), None
+        try:
+            return super().planes_at(body_vertices, pose, t, reach)
+        finally:
+            self.grid, self.reach, self._compiled = saved
+
+    def candidates(self, surface_set, body, pose, x, t, margin):
+        """The vertices inside its bounding box grown by ``margin``, if the
+        fcl broad phase finds the body within ``margin`` of it."""
+        if self not in surface_set.meshes_within(body, pose, t, margin):
+            return np.zeros(0, dtype=np.int64)
+        rotation, frame = self.frame(t)
+        y = (x - frame[0]) @ rotation
+        lo, hi = self.vertices.min(axis=0) - margin, self.vertices.max(axis=0) + margin
+        return np.flatnonzero(np.all((y >= lo) & (y <= hi), axis=1))
+
+    def transform(self, t):
+        """Its fcl transform at ``t`` (frozen when static in shape)."""
+        rotation, frame = self.frame(t)
+        return fcl.Transform(rotation.copy(), frame[0].copy())
+
+    def drawing(self, extent):
+        return self.vertices, self.faces
+
+    def describe(self):
+        text = super().describe()
+        if self.motion.rate and not self.invariant:
+            text += " (not a surface of revolution about that axis: its turn changes its shape)"
+        return text
