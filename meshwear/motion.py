@@ -2,7 +2,9 @@
 
 A motion owns one rule: given a body's pose at time ``t`` and the contact
 wrench on it, produce the pose at ``t + dt``. Contact never calls back into a
-motion, so the step order stays in :func:`meshwear.simulate.step`.
+motion, so the step order stays in :func:`meshwear.simulate.step`. Each is a
+kind and a parameter array of :mod:`meshwear.kernels.rigid`, so the compiled
+step loop (:mod:`meshwear.kernels.loop`) runs the same kernels.
 
 Every motion implements
 
@@ -20,8 +22,9 @@ In quasi-static runs, :class:`BalancedMotion` (a guided body) also has
 import numpy as np
 
 from .kernels.balance import balance_offset
-from .kernels.rigid import (CIRCLE, OSCILLATION, STEADY, free_step, guided_step,
-                            path_point, place_on_path)
+from .kernels.rigid import (ACCELERATION, AXIS, BALANCED, CARRIED, CIRCLE, FIXED, FREE, GUIDED,
+                            INERTIA, INVERSE_INERTIA, INVERSE_MASS, MOTION_PARAMS, OSCILLATION,
+                            PRESCRIBED, START, STEADY, advance_motion, path_point, place_motion)
 
 
 class Path:
@@ -77,67 +80,81 @@ def _perpendicular(normal):
     raise ValueError("degenerate normal")  # unreachable for a unit normal
 
 
-class FreeMotion:
+class Motion:
+    """A motion as the kernels see it: its ``kind`` (:mod:`meshwear.kernels.rigid`),
+    ``params`` (29,) and path ``terms``; :meth:`place` and :meth:`advance`
+    call the same kernels as the compiled step loop."""
+
+    kind = FIXED
+    dynamic_axes = None
+
+    def __init__(self, path=None, start=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 0.0), mass=np.nan,
+                 inertia=None, acceleration=(0.0, 0.0, 0.0), carried=0.0):
+        self.path = path if path is not None else Path()
+        self.params = np.zeros(MOTION_PARAMS)
+        self.params[INVERSE_MASS] = 1.0 / mass if np.isfinite(mass) else 0.0
+        if inertia is not None:
+            self.params[INERTIA] = np.ravel(inertia)
+            self.params[INVERSE_INERTIA] = np.linalg.inv(inertia).ravel()
+        self.params[ACCELERATION] = acceleration
+        self.params[AXIS] = axis
+        self.params[START] = start
+        self.params[CARRIED] = carried
+
+    @property
+    def terms(self):
+        return self.path.terms
+
+    @property
+    def start(self):
+        return self.params[START]
+
+    @property
+    def axis(self):
+        return self.params[AXIS]
+
+    def place(self, pose, t):
+        """Set the path-driven parts of ``pose`` at time ``t``."""
+        place_motion(self.kind, self.params, self.path.terms, self.path.buffer, pose, float(t))
+
+    def advance(self, pose, wrench, t, dt):
+        """Advance ``pose`` from ``t`` to ``t + dt`` under the contact ``wrench``."""
+        advance_motion(self.kind, self.params, self.path.terms, self.path.buffer, pose, wrench,
+                       float(t), float(dt))
+
+
+class FreeMotion(Motion):
     """Newton-Euler with gravity and a constant force, symplectic Euler step."""
 
+    kind = FREE
     dynamic_axes = "all"
 
     def __init__(self, mass, inertia, acceleration):
-        self.inverse_mass = 1.0 / mass
-        self.inertia = np.ascontiguousarray(inertia, dtype=float)
-        self.inverse_inertia = np.ascontiguousarray(np.linalg.inv(inertia))
-        self.acceleration = np.asarray(acceleration, float)
-
-    def place(self, pose, t):
-        pass
-
-    def advance(self, pose, wrench, t, dt):
-        free_step(pose, wrench, self.inverse_mass, self.inertia, self.inverse_inertia,
-                  self.acceleration, dt)
+        super().__init__(mass=mass, inertia=np.asarray(inertia, float), acceleration=acceleration)
 
 
-class PrescribedMotion:
+class PrescribedMotion(Motion):
     """All translations follow ``start + path(t)``; orientation fixed."""
 
-    dynamic_axes = None
+    kind = PRESCRIBED
 
     def __init__(self, start, path):
-        self.start = np.asarray(start, float)
-        self.path = path
-        self.no_axis = np.zeros(3)
-
-    def place(self, pose, t):
-        place_on_path(pose, self.start, self.path.terms, self.no_axis, 0.0, 0.0, t,
-                      self.path.buffer)
-
-    def advance(self, pose, wrench, t, dt):
-        self.place(pose, t + dt)
+        super().__init__(path, start)
 
 
-class GuidedMotion:
+class GuidedMotion(Motion):
     """Translation along ``free_axis`` is dynamic (contact, gravity, applied
     force); every other degree of freedom follows ``start + path(t)``. The
     path's component along the free axis is dropped."""
 
+    kind = GUIDED
     dynamic_axes = "axis"
 
     def __init__(self, start, path, free_axis, mass, acceleration):
-        self.axis = np.asarray(free_axis, float)
-        self.start = np.asarray(start, float)
-        self.path = path
-        self.inverse_mass = 1.0 / mass
-        self.acceleration = np.asarray(acceleration, float)
-
-    def place(self, pose, t):
-        place_on_path(pose, self.start, self.path.terms, self.axis, pose[0:3] @ self.axis,
-                      pose[7:10] @ self.axis, t, self.path.buffer)
-
-    def advance(self, pose, wrench, t, dt):
-        guided_step(pose, wrench, self.inverse_mass, self.acceleration, self.axis, self.start,
-                    self.path.terms, t, dt, self.path.buffer)
+        super().__init__(path, start, free_axis, mass=mass, acceleration=acceleration)
 
 
-class BalancedMotion:
+class BalancedMotion(Motion):
     """Quasi-static guided body: every degree of freedom but ``free_axis``
     follows ``start + path(t)``; along the axis the body sits where the
     contact normal forces balance the applied ``load`` (N along the axis:
@@ -145,42 +162,38 @@ class BalancedMotion:
     :func:`meshwear.kernels.balance.balance_offset`. No inertia, no damping.
     """
 
-    dynamic_axes = None
+    kind = BALANCED
 
     def __init__(self, start, path, free_axis, load):
-        self.axis = np.asarray(free_axis, float)
-        self.start = np.asarray(start, float)
-        self.path = path
-        #: contact force the planes must supply along the axis (N)
-        self.carried = -float(load)
+        #: contact force the planes must supply along the axis (N): params[CARRIED]
+        super().__init__(path, start, free_axis, carried=-float(load))
         self.scratch = np.zeros((2, 0))
 
-    def place(self, pose, t):
-        place_on_path(pose, self.start, self.path.terms, self.axis, pose[0:3] @ self.axis,
-                      0.0, t, self.path.buffer)
+    @property
+    def carried(self):
+        return self.params[CARRIED]
+
+    def ensure_scratch(self, pairs):
+        """Grow the balance's work array to ``pairs`` vertex-surface pairs."""
+        if self.scratch.shape[1] < pairs:
+            self.scratch = np.zeros((2, pairs))
+        return self.scratch
 
     def settle(self, pose, vertices, area_vectors, planes, vertex_planes, active, law):
         """Move ``pose`` along the axis to the balance; False if no contact
         can carry the load (arrays as for
         :func:`meshwear.kernels.balance.balance_offset`)."""
-        pairs = len(active) * (planes.shape[0] + vertex_planes.shape[0])
-        if self.scratch.shape[1] < pairs:
-            self.scratch = np.zeros((2, pairs))
+        scratch = self.ensure_scratch(len(active) * (planes.shape[0] + vertex_planes.shape[0]))
         z = balance_offset(vertices, pose, self.axis, planes, vertex_planes, active, area_vectors,
-                           law, self.carried, 0.0, self.scratch)
+                           law, self.carried, 0.0, scratch)
         if not np.isfinite(z):
             return False
-        pose[0:3] += z * self.axis
+        for j in range(3):
+            pose[j] += z * self.axis[j]
         return True
 
 
-class FixedMotion:
+class FixedMotion(Motion):
     """The body does not move."""
 
-    dynamic_axes = None
-
-    def place(self, pose, t):
-        pose[7:13] = 0.0
-
-    def advance(self, pose, wrench, t, dt):
-        pass
+    kind = FIXED

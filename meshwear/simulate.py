@@ -8,7 +8,7 @@ the dynamics of every body from the contact wrench just computed.
 
 import numpy as np
 
-from . import surfaces
+from . import stepper, surfaces
 from .geometry import inverted_faces
 from .model import body_contact
 from .output.memory import MemoryHistory
@@ -23,49 +23,72 @@ class NumericalError(RuntimeError):
 
 
 def step(model, state):
-    """Advance ``state`` by one time step of ``model``, in place."""
+    """Advance ``state`` by one time step of ``model``, in place: the Python
+    reference of the compiled loop (:func:`advance` uses that)."""
+    for body, s in zip(model.bodies, state.bodies):
+        step_body(model, body, s, state.step)
+    state.step += 1
+    state.time = state.step * model.dt
+
+
+def step_body(model, body, s, k):
+    """Step ``k`` of one body (bodies act on counter-surfaces only, never on
+    each other, so each can be stepped on its own)."""
     if model.quasi_static:
-        _quasi_static_step(model, state)
+        _quasi_static_step(model, body, s, k)
         return
-    for body, s in zip(model.bodies, state.bodies):
-        surfaces.update(model, body, s, state.time)
-        body_contact(model, body, s)
-    for body, s in zip(model.bodies, state.bodies):
-        body.motion.advance(s.pose, s.wrench, state.time, model.dt)
-    state.step += 1
-    state.time = state.step * model.dt
+    t = k * model.dt
+    surfaces.update(model, body, s, t)
+    touch(model, body, s)
+    body.motion.advance(s.pose, s.wrench, t, model.dt)
 
 
-def _quasi_static_step(model, state):
-    """Quasi-static: put every body where it is at the end of the step (on its
-    path, guided ones in load balance), with the velocity of that increment,
-    then evaluate contact, friction and wear there. Friction thus follows the
-    tangential displacement increments, and the contact forces of the new
-    state carry its load exactly."""
-    t = (state.step + 1) * model.dt
-    for body, s in zip(model.bodies, state.bodies):
-        before = s.pose[0:3].copy()
-        body.motion.place(s.pose, t)
+def _quasi_static_step(model, body, s, k):
+    """Quasi-static: put the body where it is at the end of the step (on its
+    path, a guided one in load balance), with the velocity of that
+    increment, then evaluate contact, friction and wear there. Friction thus
+    follows the tangential displacement increments, and the contact forces
+    of the new state carry its load exactly."""
+    t = (k + 1) * model.dt
+    before = s.pose[0:3].copy()
+    body.motion.place(s.pose, t)
+    s.pose[7:10] = (s.pose[0:3] - before) / model.dt
+    s.pose[10:13] = 0.0
+    # the planes under the vertices where the path puts the body, then the
+    # balance along its free axis on them
+    surfaces.update(model, body, s, t)
+    settle = getattr(body.motion, "settle", None)
+    if settle is not None:
+        if not settle(s.pose, s.vertices, body.area_vectors, model.planes, s.vertex_planes,
+                      s.active, model.law):
+            raise no_balance(body, t)
         s.pose[7:10] = (s.pose[0:3] - before) / model.dt
-        s.pose[10:13] = 0.0
-        # the faces under the vertices where the path puts the body, then the
-        # balance along its free axis on their planes
-        surfaces.update(model, body, s, t)
-        settle = getattr(body.motion, "settle", None)
-        if settle is not None:
-            if not settle(s.pose, s.vertices, body.area_vectors, model.planes, s.vertex_planes,
-                          s.active, model.law):
-                raise NumericalError(f"body {body.name!r}: no contact carries its load at "
-                                     f"t = {t:.6g} s")
-            s.pose[7:10] = (s.pose[0:3] - before) / model.dt
-            if surfaces.moved_since_refresh(model, body, s, t) >= s.cull[surfaces.CULL_MARGIN]:
-                surfaces.update(model, body, s, t)
-        body_contact(model, body, s)
-    state.step += 1
-    state.time = state.step * model.dt
+        if surfaces.moved_since_refresh(model, body, s, t) >= s.cull[surfaces.CULL_MARGIN]:
+            finish_step(model, body, s, t)
+            return
+    touch(model, body, s)
 
 
-def run(model, state, observers=(), progress=None, checkpoint=None):
+def finish_step(model, body, s, t):
+    """The rest of a quasi-static step whose settling move reached the
+    active-set bound: refresh, planes at ``t``, contact."""
+    surfaces.update(model, body, s, t)
+    touch(model, body, s)
+
+
+def touch(model, body, s):
+    """One step of the contact kernel, and the peak normal forces if kept."""
+    body_contact(model, body, s)
+    if len(s.peak):
+        a = s.active
+        s.peak[a] = np.maximum(s.peak[a], s.normal_force[:, a].sum(axis=0))
+
+
+def no_balance(body, t):
+    return NumericalError(f"body {body.name!r}: no contact carries its load at t = {t:.6g} s")
+
+
+def run(model, state, observers=(), progress=None, checkpoint=None, compiled=True):
     """Run ``state`` from its current step to the end of ``model``'s duration.
 
     Parameters
@@ -83,6 +106,9 @@ def run(model, state, observers=(), progress=None, checkpoint=None):
     checkpoint : callable, optional
         ``checkpoint(model, state)``, called at points where the state can be
         saved and resumed from (every output written up to its step).
+    compiled : bool
+        Step with the compiled loop (default), or with the Python reference
+        :func:`step` (the same numbers, slower; for tests).
 
     Raises
     ------
@@ -93,14 +119,15 @@ def run(model, state, observers=(), progress=None, checkpoint=None):
     if model.cycle_steps:
         from .wear import run_cycle_jump
 
-        return run_cycle_jump(model, state, observers, progress, checkpoint)
-    advance(model, state, model.n_steps, observers, progress, checkpoint)
+        return run_cycle_jump(model, state, observers, progress, checkpoint, compiled=compiled)
+    advance(model, state, model.n_steps, observers, progress, checkpoint, compiled)
     return state
 
 
-def advance(model, state, stop, observers=(), progress=None, checkpoint=None):
+def advance(model, state, stop, observers=(), progress=None, checkpoint=None, compiled=True):
     """Step ``state`` up to step ``stop``, writing every output due on the way
-    (those of the current step first, unless already written)."""
+    (those of the current step first, unless already written); by the
+    compiled loop (:mod:`meshwear.stepper`), or step by step in Python."""
     schedule = model.output_steps
     while True:
         if state.step > state.written:
@@ -111,6 +138,8 @@ def advance(model, state, stop, observers=(), progress=None, checkpoint=None):
             return
         following = schedule[np.searchsorted(schedule, state.step, side="right")]
         until = min(stop, following, state.step + PROGRESS_STEPS)
+        if compiled:
+            stepper.advance(model, state, until)
         while state.step < until:
             step(model, state)
         if progress is not None:

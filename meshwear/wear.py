@@ -105,7 +105,8 @@ def choose_jump(rate, previous, gap, penetration_, tolerance, last_jump, limit, 
     return max(0, int(np.floor(bounds[which]))), which
 
 
-def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, forced_jump=None):
+def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, forced_jump=None,
+                   compiled=True):
     """Run ``state`` to the end of ``model``'s duration, jumping over cycles.
 
     ``forced_jump`` replaces the controller by a fixed jump (still stopping at
@@ -125,7 +126,7 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
         before = [(s.wear_depth.copy(), s.vertices.copy(), s.wear_volume.copy(),
                    s.friction_work.copy()) for s in state.bodies]
         stop = min(start + n_c, model.n_steps)
-        advance(model, state, stop, observers, progress)
+        advance(model, state, stop, observers, progress, compiled=compiled)
         js.resolved_steps += stop - start
         if stop - start < n_c or state.step >= model.n_steps:
             break

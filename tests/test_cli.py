@@ -581,18 +581,20 @@ def test_wear_through_the_thickness_stops_with_exit_3_and_valid_outputs(tmp_path
 
 
 def test_non_finite_state_stops_with_exit_3(tmp_path, capsys, caplog, monkeypatch):
-    """A state that turns NaN mid-run (injected after step 400 of 1000) stops the
-    run at the next sample with exit 3; the samples before it stay valid."""
-    import meshwear.simulate
+    """A state that turns NaN mid-run (injected once the run passes step 400
+    of 1000) stops the run at the next sample with exit 3; the samples before
+    it stay valid."""
+    import meshwear.stepper
 
-    real_step = meshwear.simulate.step
+    real_advance = meshwear.stepper.advance
 
-    def step(model, state):
-        real_step(model, state)
-        if state.step == 400:
+    def advance(model, state, until):
+        before = state.step
+        real_advance(model, state, until)
+        if before < 400 <= state.step:
             state.bodies[0].pose[7] = float("nan")
 
-    monkeypatch.setattr(meshwear.simulate, "step", step)
+    monkeypatch.setattr(meshwear.stepper, "advance", advance)
     scene = write(tmp_path / "scene.toml", BASE)
     out_dir = tmp_path / "out"
     code, out, err = cli(capsys, caplog, "run", scene, "-o", out_dir, "-q")

@@ -160,3 +160,44 @@ def guided_step(pose, wrench, inverse_mass, acceleration, axis, start, terms, t,
     rate += dt * a
     along += dt * rate
     place_on_path(pose, start, terms, axis, along, rate, t + dt, buffer)
+
+
+#: motion kinds of :func:`place_motion` and :func:`advance_motion`
+FIXED, FREE, GUIDED, PRESCRIBED, BALANCED = 0, 1, 2, 3, 4
+#: slots of a motion's ``params`` (29,)
+INVERSE_MASS, INERTIA, INVERSE_INERTIA, ACCELERATION, AXIS, START, CARRIED = (
+    0, slice(1, 10), slice(10, 19), slice(19, 22), slice(22, 25), slice(25, 28), 28)
+MOTION_PARAMS = 29
+
+
+@njit(cache=True)
+def place_motion(kind, params, terms, buffer, pose, t):
+    """Put the path-driven part of ``pose`` where a motion of ``kind`` has it
+    at ``t`` (a guided body keeps its place and rate along its free axis; a
+    balanced one its place, at rate 0; a fixed one stops)."""
+    if kind == FIXED:
+        for j in range(7, 13):
+            pose[j] = 0.0
+    elif kind == PRESCRIBED:
+        place_on_path(pose, params[START], terms, np.zeros(3), 0.0, 0.0, t, buffer)
+    elif kind == GUIDED or kind == BALANCED:
+        axis = params[AXIS]
+        along = pose[0] * axis[0] + pose[1] * axis[1] + pose[2] * axis[2]
+        rate = 0.0
+        if kind == GUIDED:
+            rate = pose[7] * axis[0] + pose[8] * axis[1] + pose[9] * axis[2]
+        place_on_path(pose, params[START], terms, axis, along, rate, t, buffer)
+
+
+@njit(cache=True)
+def advance_motion(kind, params, terms, buffer, pose, wrench, t, dt):
+    """Advance ``pose`` from ``t`` to ``t + dt`` under the contact ``wrench``
+    (dynamic mode)."""
+    if kind == FREE:
+        free_step(pose, wrench, params[INVERSE_MASS], params[INERTIA].reshape(3, 3),
+                  params[INVERSE_INERTIA].reshape(3, 3), params[ACCELERATION], dt)
+    elif kind == GUIDED:
+        guided_step(pose, wrench, params[INVERSE_MASS], params[ACCELERATION], params[AXIS],
+                    params[START], terms, t, dt, buffer)
+    elif kind == PRESCRIBED:
+        place_on_path(pose, params[START], terms, np.zeros(3), 0.0, 0.0, t + dt, buffer)

@@ -21,7 +21,8 @@ import fcl
 import numpy as np
 
 from ..kernels.contact import FACING, FORCE, NO_CONTACT
-from ..kernels.frames import BOUNDS_SIZE, moved_since_refresh as _moved, step_motion as _step
+from ..kernels.frames import (BOUNDS_SIZE, MOTION_SIZE, moved_since_refresh as _moved,
+                              step_motion as _step)
 from .base import quaternion_matrix
 from .mesh import MeshSurface, bvh
 
@@ -56,6 +57,7 @@ class SurfaceSet:
         self.manager = None
         self.body_bvh = {}
         self._near = None
+        self._compiled_planes = None
         self.refresh_bounds()
 
     @property
@@ -74,6 +76,37 @@ class SurfaceSet:
         for j, s in enumerate(slots):
             self.bounds[j] = s.bounds()
             self.terms[j, :len(s.motion.terms)] = s.motion.terms
+        self._compiled_planes = None
+
+    def compiled_planes(self):
+        """The ``planes`` tuple of :mod:`meshwear.kernels.loop`: the kernel's
+        array and, per plane, its motion, path terms, normal and point at
+        rest, and whether it moves."""
+        if getattr(self, "_compiled_planes", None) is None:
+            p = self.uniform
+            self._compiled_planes = (
+                self.planes,
+                np.array([s.motion.array for s in p]).reshape(-1, MOTION_SIZE),
+                np.ascontiguousarray(self.terms[:len(p)]),
+                np.array([s.normal for s in p], dtype=float).reshape(-1, 3),
+                np.array([s.point for s in p], dtype=float).reshape(-1, 3),
+                np.array([not s.static for s in p], dtype=np.bool_))
+        return self._compiled_planes
+
+    def compiled_list(self):
+        """The per-vertex surfaces' tuples as the numba typed list the
+        compiled loop takes (rebuilt when one changed: a face grid rebinned)."""
+        tuples = [s.compiled() for s in self.per_vertex]
+        ids = [id(t) for t in tuples]
+        if getattr(self, "_list_ids", None) != ids:
+            from numba import typed, typeof
+
+            item = typeof(tuples[0] if tuples else _sample_tuple())
+            self._list = typed.List.empty_list(item)
+            for t in tuples:
+                self._list.append(t)
+            self._list_ids = ids
+        return self._list
 
     def set_planes(self, t):
         """Put the moving uniform planes where they are at ``t``."""
@@ -123,6 +156,13 @@ class SurfaceSet:
         out = [self.meshes[j] for j in sorted(found)]
         self._near = (key, out)
         return out
+
+
+def _sample_tuple():
+    """A surface tuple, for the item type of an empty typed list."""
+    from .analytic import Sphere
+
+    return Sphere("sample", 1.0, (0.0, 0.0, 0.0)).compiled()
 
 
 @dataclass

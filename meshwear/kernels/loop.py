@@ -1,0 +1,163 @@
+"""The compiled step loop: many steps of one body without returning to Python.
+
+:func:`advance_body` runs the steps of :func:`meshwear.simulate.step_body`
+(the Python reference it must match to the last bit) for one worn body, from
+step ``k`` up to ``stop``, and hands back to Python whatever it does not do
+itself: an active-set refresh (before the step that needs it, having changed
+nothing of that step, or, in the quasi-static mode, after the settling move
+of a step, for Python to finish it), and a load nothing carries. Bodies do
+not act on one another (only on counter-surfaces), so each runs on its own
+between two output times.
+
+Arguments are grouped in tuples (:mod:`meshwear.stepper` packs them):
+
+body
+    ``vertices, pose, area, law, wear_direction, contact_state, tangential,
+    normal_force, friction_work, wear_depth, wear_volume, wrench,
+    vertex_planes, hint, active, active_wear, cull, distance, peak`` (the
+    arrays of :class:`meshwear.model.BodyState` and its model; ``peak`` (n,)
+    keeps each vertex's largest total normal force, or is empty) and
+    ``radius`` (m).
+motion
+    ``kind`` and ``params`` (:mod:`meshwear.kernels.rigid`), the path
+    ``terms``, ``buffer`` (2, 3) and the balance's ``scratch`` (2, m), at
+    least as long as the active vertices times the slots.
+planes
+    The contact kernel's ``planes`` (P, 4, 3) and, per plane, its motion
+    (P, 19), path terms (P, K, 9), normal and point at rest (P, 3) and
+    whether it moves (P,) (:func:`meshwear.kernels.frames.plane_rows`).
+surfaces
+    A typed list of surface tuples (:mod:`meshwear.kernels.counter`).
+bounds, terms
+    The active-set bounds of every slot (:mod:`meshwear.kernels.frames`).
+"""
+
+import numpy as np
+from numba import njit
+
+from .balance import balance_offset
+from .contact import PARALLEL_THRESHOLD, contact_parallel, contact_serial
+from .counter import fill_planes
+from .frames import moved_since_refresh, plane_rows, step_motion
+from .rigid import AXIS, BALANCED, CARRIED, advance_motion, place_motion
+
+#: what :func:`advance_body` returns besides the step it reached
+DONE, REFRESH, FINISH, NO_BALANCE = 0, 1, 2, 3
+
+
+@njit(cache=True)
+def _fill(body, planes, surfaces, t, buffer, rotation, frame):
+    """The planes of every surface at ``t`` under the body's active vertices."""
+    vertices, pose = body[0], body[1]
+    vertex_planes, hint, active, distance = body[12], body[13], body[14], body[17]
+    plane_array, plane_motion, plane_terms, normal0, point0, moving = planes
+    for j in range(plane_array.shape[0]):
+        if moving[j]:
+            plane_rows(plane_motion[j], plane_terms[j], normal0[j], point0[j], t, buffer,
+                       plane_array[j])
+    for j in range(len(surfaces)):
+        fill_planes(surfaces[j], t, vertices, pose, active, vertex_planes[j], distance, hint[j],
+                    buffer, rotation, frame)
+
+
+@njit(cache=True)
+def _touch(body, plane_array):
+    """One step of the contact kernel; the peak normal forces."""
+    (vertices, pose, area, law, wear_direction, contact_state, tangential, normal_force,
+     friction_work, wear_depth, wear_volume, wrench, vertex_planes, hint, active, active_wear,
+     cull, distance, peak, radius) = body
+    slots = plane_array.shape[0] + vertex_planes.shape[0]
+    if active.shape[0] * slots >= PARALLEL_THRESHOLD:
+        contact_parallel(vertices, pose, plane_array, vertex_planes, active, area, law,
+                         wear_direction, contact_state, tangential, normal_force, friction_work,
+                         wear_depth, wear_volume, wrench)
+    else:
+        contact_serial(vertices, pose, plane_array, vertex_planes, active, area, law,
+                       wear_direction, contact_state, tangential, normal_force, friction_work,
+                       wear_depth, wear_volume, wrench)
+    if peak.shape[0]:
+        for k in range(active.shape[0]):
+            i = active[k]
+            total = 0.0
+            for s in range(slots):
+                total += normal_force[s, i]
+            if total > peak[i]:
+                peak[i] = total
+
+
+@njit(cache=True)
+def _needs_refresh(body, bounds, terms, t, dt, buffer, cull_enabled):
+    """``meshwear.surfaces.needs_refresh``: the active set must be rebuilt before a step at ``t``."""
+    pose, wear_depth, active, active_wear, cull, radius = (body[1], body[9], body[14], body[15],
+                                                           body[16], body[19])
+    if not cull_enabled:
+        return False
+    if cull[0] == 0.0:
+        return True
+    return (moved_since_refresh(pose, cull, radius, bounds, terms, t, wear_depth, active,
+                                active_wear, buffer)
+            + step_motion(pose, radius, bounds, terms, t, dt, buffer) >= cull[0])
+
+
+@njit(cache=True)
+def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, surfaces, bounds,
+                 terms):
+    """Step one body from step ``k`` up to ``stop``. Returns ``(step, what)``:
+    the step reached and :data:`DONE` (``step == stop``), :data:`REFRESH`
+    (step ``step`` needs an active-set refresh first; nothing of it is done),
+    :data:`FINISH` (quasi-static: step ``step`` is placed, its planes queried
+    and the body settled, but its bound is reached: refresh, query and touch
+    are left) or :data:`NO_BALANCE` (no contact carries the load at step ``step``)."""
+    vertices, pose, area, law = body[0], body[1], body[2], body[3]
+    vertex_planes, active, cull, radius = body[12], body[14], body[16], body[19]
+    kind, params, path_terms, buffer, scratch = motion
+    plane_array = planes[0]
+    rotation, frame = np.zeros((3, 3)), np.zeros((4, 3))
+    placed = np.zeros(13)
+    if (quasi_static and kind == BALANCED
+            and scratch.shape[1] < active.shape[0] * (plane_array.shape[0] + vertex_planes.shape[0])):
+        return k, REFRESH                # Python grows the scratch
+    while k < stop:
+        if not quasi_static:
+            t = k * dt
+            if _needs_refresh(body, bounds, terms, t, dt, buffer, cull_enabled):
+                return k, REFRESH
+            _fill(body, planes, surfaces, t, buffer, rotation, frame)
+            _touch(body, plane_array)
+            advance_motion(kind, params, path_terms, buffer, pose, body[11], t, dt)
+            k += 1
+            continue
+        # quasi-static: where the path puts the body at the end of the step,
+        # with the velocity of that increment (on a copy: a refresh must find
+        # the step untouched)
+        t = (k + 1) * dt
+        for j in range(13):
+            placed[j] = pose[j]
+        place_motion(kind, params, path_terms, buffer, placed, t)
+        for j in range(3):
+            placed[7 + j] = (placed[j] - pose[j]) / dt
+        for j in range(10, 13):
+            placed[j] = 0.0
+        saved = pose.copy()
+        for j in range(13):
+            pose[j] = placed[j]
+        if _needs_refresh(body, bounds, terms, t, dt, buffer, cull_enabled):
+            for j in range(13):
+                pose[j] = saved[j]
+            return k, REFRESH
+        _fill(body, planes, surfaces, t, buffer, rotation, frame)
+        if kind == BALANCED:
+            z = balance_offset(vertices, pose, params[AXIS], plane_array, vertex_planes, active,
+                               area, law, params[CARRIED], 0.0, scratch)
+            if not np.isfinite(z):
+                return k, NO_BALANCE
+            for j in range(3):
+                pose[j] += z * params[AXIS][j]
+            for j in range(3):
+                pose[7 + j] = (pose[j] - saved[j]) / dt
+            if cull_enabled and moved_since_refresh(pose, cull, radius, bounds, terms, t,
+                                                    body[9], active, body[15], buffer) >= cull[0]:
+                return k, FINISH
+        _touch(body, plane_array)
+        k += 1
+    return k, DONE

@@ -1,0 +1,60 @@
+"""The compiled step loop, Python side: pack a model's arrays for
+:func:`meshwear.kernels.loop.advance_body` and take back the steps it leaves.
+
+The loop runs whole spans of steps of one body inside numba. It returns to
+Python for an active-set refresh (python-fcl, numpy: done by the reference
+step :func:`meshwear.simulate.step_body`, or :func:`meshwear.simulate.finish_step`
+for the rest of a quasi-static step), for a load nothing can carry, and at the
+``until`` step the caller asks for (outputs, checkpoints, progress).
+"""
+
+import numpy as np
+
+from .kernels import loop
+from .kernels.rigid import BALANCED
+
+
+def _body_arrays(model, body, s):
+    """The ``body`` tuple of :mod:`meshwear.kernels.loop`."""
+    return (s.vertices, s.pose, body.area_vectors, model.law, body.wear_direction,
+            s.contact_state, s.tangential, s.normal_force, s.friction_work, s.wear_depth,
+            s.wear_volume, s.wrench, s.vertex_planes, s.hint, s.active, s.active_wear, s.cull,
+            s.cull_scratch.distance, s.peak, float(body.radius))
+
+
+def _motion_arrays(model, body, s):
+    """The ``motion`` tuple of :mod:`meshwear.kernels.loop`."""
+    m = body.motion
+    if m.kind == BALANCED and model.quasi_static:
+        scratch = m.ensure_scratch(len(s.active) * model.slots)
+    else:
+        scratch = np.zeros((2, 0))
+    return (int(m.kind), m.params, m.path.terms, m.path.buffer, scratch)
+
+
+def advance(model, state, until):
+    """Step every body of ``state`` from ``state.step`` to step ``until``."""
+    from .simulate import finish_step, no_balance, step_body
+
+    dt = model.dt
+    surfaces = model.surfaces
+    planes = surfaces.compiled_planes()
+    for body, s in zip(model.bodies, state.bodies):
+        k = state.step
+        while k < until:
+            k, what = loop.advance_body(k, until, dt, model.quasi_static, model.cull,
+                                        _body_arrays(model, body, s),
+                                        _motion_arrays(model, body, s), planes,
+                                        surfaces.compiled_list(), surfaces.bounds,
+                                        surfaces.terms)
+            if what == loop.DONE:
+                break
+            if what == loop.REFRESH:
+                step_body(model, body, s, k)
+            elif what == loop.FINISH:
+                finish_step(model, body, s, (k + 1) * dt)
+            else:
+                raise no_balance(body, (k + 1) * dt)
+            k += 1
+    state.step = until
+    state.time = until * dt
