@@ -39,7 +39,8 @@ def scene_digest(scene):
 def save(path, model, state, wall_time):
     """Write ``state`` to ``path`` atomically (a reader sees the old or the new file)."""
     arrays = {"digest": np.array(scene_digest(model.scene)),
-              "scalars": np.array([state.time, state.step, state.written, wall_time], dtype=float)}
+              "scalars": np.array([state.time, state.step, state.written, wall_time,
+                                   float(state.resolved)], dtype=float)}
     for k, s in enumerate(state.bodies):
         for name in _BODY_ARRAYS:
             arrays[f"body{k}_{name}"] = getattr(s, name)
@@ -92,8 +93,13 @@ def load(path, model, state):
     if digest != scene_digest(model.scene):
         raise SceneError(model.scene.source, "", f"{path} was written for another version of this "
                          "scene or its meshes; run without --resume to start again")
-    t, step, written, wall = data["scalars"]
+    scalars = data["scalars"]
+    if len(scalars) != 5:
+        raise SceneError(model.scene.source, "", f"{path} was written by another version of "
+                         "meshwear; run without --resume to start again")
+    t, step, written, wall, resolved = scalars
     state.time, state.step, state.written = float(t), int(step), int(written)
+    state.resolved = bool(resolved)
     try:
         for k, s in enumerate(state.bodies):
             for name in _BODY_ARRAYS:

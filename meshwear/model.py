@@ -170,14 +170,17 @@ class BodyState:
 @dataclass(eq=False)
 class State:
     """Where a run is: ``step`` steps of ``dt`` represented (``time``), the
-    bodies' state, the last step whose outputs are written, and the cycle
-    jumping's bookkeeping (:class:`meshwear.wear.JumpState`, or None)."""
+    bodies' state, the last step whose outputs are written, the cycle
+    jumping's bookkeeping (:class:`meshwear.wear.JumpState`, or None) and
+    whether the state was reached by steps (``resolved``) or by a jump."""
 
     time: float
     step: int
     bodies: list
     written: int = -1
     jump: object = None
+    #: False from a cycle jump until the next step: the state is extrapolated
+    resolved: bool = True
 
 
 def build_model(scene):

@@ -80,6 +80,10 @@ def _perpendicular(normal):
     raise ValueError("degenerate normal")  # unreachable for a unit normal
 
 
+#: no per-vertex stiffness scale in the balance
+NO_SCALE = np.zeros(0)
+
+
 class Motion:
     """A motion as the kernels see it: its ``kind`` (:mod:`meshwear.kernels.rigid`),
     ``params`` (29,) and path ``terms``; :meth:`place` and :meth:`advance`
@@ -185,7 +189,7 @@ class BalancedMotion(Motion):
         :func:`meshwear.kernels.balance.balance_offset`)."""
         scratch = self.ensure_scratch(len(active) * (planes.shape[0] + vertex_planes.shape[0]))
         z = balance_offset(vertices, pose, self.axis, planes, vertex_planes, active, area_vectors,
-                           law, self.carried, 0.0, scratch)
+                           law, self.carried, 0.0, scratch, NO_SCALE)
         if not np.isfinite(z):
             return False
         for j in range(3):

@@ -30,6 +30,7 @@ MODES = ("dynamic", "quasi-static")
 WEAR_LAWS = ("energy", "energy_density", "archard")
 WEAR_DIRECTIONS = ("contact_normal", "vertex_normal")
 ACCELERATIONS = ("none", "cycle_jump")
+JUMPS = ("implicit", "explicit")
 UNITS = ("m", "mm", "cm", "um", "in")
 MOTIONS = ("free", "guided", "prescribed", "fixed")
 SURFACE_TYPES = ("plane", "mesh", "cylinder", "sphere")
@@ -162,7 +163,11 @@ class WearConfig:
     """``[wear]``: law, coefficient (m/J, m³/J or 1/Pa), direction, acceleration.
 
     ``period`` (s) is the cycle length for ``cycle_jump`` (None: from the
-    motion's frequency); ``tolerance`` the relative error allowed on wear depth.
+    motion's frequency); ``tolerance`` the relative error allowed on wear depth;
+    ``jump`` how a jump extrapolates the wear: ``"implicit"`` (backward Euler,
+    the pressure re-balanced against the worn geometry; stable for any jump)
+    or ``"explicit"`` (the last cycle's wear times the jump, bounded for
+    stability).
     """
 
     law: str = "energy"
@@ -171,12 +176,14 @@ class WearConfig:
     acceleration: str = "none"
     period: float | None = None
     tolerance: float = 0.01
+    jump: str = "implicit"
 
     def __post_init__(self):
         _set(self, "law", _choice, WEAR_LAWS)
         _set(self, "coefficient", _nonnegative)
         _set(self, "direction", _choice, WEAR_DIRECTIONS)
         _set(self, "acceleration", _choice, ACCELERATIONS)
+        _set(self, "jump", _choice, JUMPS)
         _set_optional(self, "period", _positive)
         _set(self, "tolerance", _real)
         if not 0.0 < self.tolerance < 1.0:

@@ -142,6 +142,7 @@ def advance(model, state, stop, observers=(), progress=None, checkpoint=None, co
             stepper.advance(model, state, until)
         while state.step < until:
             step(model, state)
+        state.resolved = True
         if progress is not None:
             progress(state.step, model.n_steps)
         if checkpoint is not None and state.step not in model.output_steps_set:

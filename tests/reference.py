@@ -186,7 +186,7 @@ def guided_step(pose, wrench, inverse_mass, acceleration, axis, start, terms, t,
 
 
 def balance_offset(body_vertices, pose, axis, planes, vertex_planes, active, area_vectors, law,
-                   load):
+                   load, scale=None):
     """Same contract as :func:`meshwear.kernels.balance.balance_offset`, solved
     by another route: sort every breakpoint of the piecewise-linear contact
     force g(z), evaluate g there, and interpolate in the piece that holds the
@@ -204,7 +204,8 @@ def balance_offset(body_vertices, pose, axis, planes, vertex_planes, active, are
         c = law[5] + law[6] * area
         ok = (beta != 0.0) & (area > FACING * av[:, 3]) & (c > 0.0)
         zs.append(-_dot(x - p, n)[ok] / beta[ok])
-        ws.append(c[ok] * beta[ok] ** 2)
+        stiffness = c if scale is None else c * scale[active]
+        ws.append(stiffness[ok] * beta[ok] ** 2)
         signs.append(np.sign(beta[ok]))
     z_j, w, sign = np.concatenate(zs), np.concatenate(ws), np.concatenate(signs)
     carrying = sign > 0 if load >= 0 else sign < 0

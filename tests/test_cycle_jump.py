@@ -39,11 +39,18 @@ def test_accuracy_bound_follows_the_change_of_the_rate():
     assert jump == int(2 * 0.01 * 1.1e-9 / 1e-12)   # the same change over 100 cycles: 22
 
 
-def test_growth_and_output_bounds():
+def test_growth_and_end_bounds():
     rate = np.full(3, 1e-9)
     steady = dict(previous=rate.copy(), gap=1.0, penetration_=np.full(3, 1.0), tolerance=0.01)
     assert choose_jump(rate, last_jump=7, limit=10_000, **steady) == (int(GROWTH * 7 + 1), "growth")
-    assert choose_jump(rate, last_jump=7, limit=3, **steady) == (3, "output")
+    assert choose_jump(rate, last_jump=7, limit=3, **steady) == (3, "end")
+
+
+def test_implicit_jumps_have_no_stability_bound():
+    rate = np.array([1e-9, 2e-9, 1e-12])
+    pen = np.array([1e-6, 1e-6, 1e-9])
+    jump, which = choose_jump(rate, rate.copy(), 1.0, pen, 0.01, 10_000, 10_000, stability=False)
+    assert which == "growth" and jump == int(GROWTH * 10_000 + 1) or jump == 10_000
 
 
 # ---------------------------------------------------------------- against resolved runs
@@ -55,20 +62,25 @@ def _scene(path, **wear):
 
 @pytest.fixture(scope="module")
 def punch():
-    """The tilted punch with a 0.5 mm cycle (k K s per cycle = 0.05), resolved
-    and jumped."""
-    scene = _scene(cases.VALIDATION / "tilted_punch.toml", acceleration="cycle_jump",
-                   period=0.01, tolerance=0.01)
-    scene = dataclasses.replace(scene, run=dataclasses.replace(scene.run, frames=0, history=3))
-    reference = build_model(dataclasses.replace(scene, wear=dataclasses.replace(
-        scene.wear, acceleration="none")))
-    ref_state = run(reference, initial_state(reference))
-    out = {"ref": (reference, ref_state)}
-    for label, forced in (("adaptive", None), ("forced", 50)):
-        model = build_model(scene)
-        state = initial_state(model)
-        run_cycle_jump(model, state, forced_jump=forced)
-        out[label] = (model, state)
+    """The tilted punch with a 0.5 mm cycle (k K s per cycle = 0.05), slid
+    0.5 m (10 s), resolved and jumped: adaptive, and forced explicit jumps of
+    50 cycles (J k K s = 2.5) and implicit ones of 500 (J k K s = 25)."""
+    out = {}
+    for duration in (1.0, 10.0):
+        scene = _scene(cases.VALIDATION / "tilted_punch.toml", acceleration="cycle_jump",
+                       period=0.01, tolerance=0.01)
+        scene = dataclasses.replace(scene, run=dataclasses.replace(scene.run, duration=duration,
+                                                                     frames=0, history=3))
+        reference = build_model(dataclasses.replace(scene, wear=dataclasses.replace(
+            scene.wear, acceleration="none")))
+        out[f"ref {duration:g}"] = (reference, run(reference, initial_state(reference)))
+        for label, forced, method in (("adaptive", None, "implicit"), ("forced", 50, "explicit"),
+                                      ("implicit", 500, "implicit")):
+            model = build_model(dataclasses.replace(scene, wear=dataclasses.replace(
+                scene.wear, jump=method)))
+            state = initial_state(model)
+            run_cycle_jump(model, state, forced_jump=forced)
+            out[f"{label} {duration:g}"] = (model, state)
     return out
 
 
@@ -80,7 +92,7 @@ def _spread(model, state):
 
 
 def test_adaptive_jumps_follow_the_resolved_profile(punch, measured):
-    (_, ref), (model, state) = punch["ref"], punch["adaptive"]
+    (_, ref), (model, state) = punch["ref 10"], punch["adaptive 10"]
     error = np.abs(state.bodies[0].wear_depth - ref.bodies[0].wear_depth).max()
     relative = error / ref.bodies[0].wear_depth.max()
     measured("punch, jumped: profile error / max depth", relative, 0.0, 1e-2)
@@ -89,11 +101,16 @@ def test_adaptive_jumps_follow_the_resolved_profile(punch, measured):
     assert 0.0 < error_estimate(state) < model.scene.wear.tolerance
 
 
-def test_forced_large_jumps_oscillate_while_the_volume_looks_right(punch, measured):
-    """J k K s = 2.5 per jump: each jump overshoots the pressure relief, so the
-    tilt of the pressure flips and grows instead of decaying as exp(-k K s);
-    the worn volume stays k P s because the load is always P."""
-    (ref_model, ref), (model, state) = punch["ref"], punch["forced"]
+def _profile_error(state, ref):
+    w, w_ref = state.bodies[0].wear_depth, ref.bodies[0].wear_depth
+    return np.abs(w - w_ref).max() / w_ref.max()
+
+
+def test_forced_large_explicit_jumps_oscillate_while_the_volume_looks_right(punch, measured):
+    """Explicit jumps of J k K s = 2.5: each overshoots the pressure relief, so
+    the tilt of the pressure flips and grows instead of decaying as
+    exp(-k K s); the worn volume stays k P s because the load is always P."""
+    (ref_model, ref), (model, state) = punch["ref 1"], punch["forced 1"]
     k, load = model.scene.wear.coefficient, 10.0
     distance = 0.05 * model.duration
     volume = state.bodies[0].wear_volume.sum()
@@ -101,13 +118,27 @@ def test_forced_large_jumps_oscillate_while_the_volume_looks_right(punch, measur
     initial = 1e13 * 5e-7 * 0.01       # K x tilt x face width
     assert _spread(ref_model, ref) < 0.01 * initial                         # resolved: decayed
     assert _spread(model, state) > 0.5 * initial                            # forced: it did not
-    profile = (np.abs(state.bodies[0].wear_depth - ref.bodies[0].wear_depth).max()
-               / ref.bodies[0].wear_depth.max())
-    measured("forced J=50 (want >5%): profile", profile, 0.0, 5e-2)
+    profile = _profile_error(state, ref)
+    measured("explicit J=50 (want >5%): profile", profile, 0.0, 5e-2)
     assert profile > 0.05
-    # the adaptive controller would not take such a jump: stability bounds it
-    adaptive = punch["adaptive"][1]
-    assert adaptive.jump.limits["stability"] > 0 or adaptive.jump.last_jump < 50
+
+
+def test_forced_implicit_jumps_ten_times_longer_stay_within_the_tolerance(punch, measured):
+    """The hard case of the explicit jump, ten times harder: implicit jumps
+    of J k K s = 25 relax each vertex's pressure by 1 / (1 + J k K s) instead
+    of overshooting it, so the tilt decays, the profile stays within the
+    tolerance of the resolved one and the volume is k P s."""
+    (ref_model, ref), (model, state) = punch["ref 10"], punch["implicit 10"]
+    k, load = model.scene.wear.coefficient, 10.0
+    assert 500 * k * 1e13 * 0.0005 == pytest.approx(25.0)
+    assert state.jump.jumps == 2 and state.jump.last_jump >= 400
+    volume = state.bodies[0].wear_volume.sum()
+    assert volume == pytest.approx(k * load * 0.05 * model.duration, rel=1e-6)
+    initial = 1e13 * 5e-7 * 0.01
+    assert _spread(model, state) < 0.01 * initial
+    profile = _profile_error(state, ref)
+    measured("implicit J k K s = 25: profile error", profile, 0.0, 1e-2)
+    assert profile < model.scene.wear.tolerance
 
 
 def test_quasi_static_fretting_jumped_against_resolved(measured):
@@ -144,3 +175,61 @@ def test_dynamic_guided_block_jumped_against_resolved(measured):
     measured("block (dynamic), jumped: max depth", depth, depth_ref, 1e-2)
     assert depth == pytest.approx(depth_ref, rel=1e-2)
     assert state.jump.jumps > 0 and state.jump.resolved_steps < 0.7 * model.n_steps
+
+
+def test_outputs_inside_jumps_are_filled_from_them_and_marked(tmp_path, measured):
+    """241 history rows and 13 frames over 600 cycles cost no resolved
+    cycle each: the rows and frames inside jumps are filled (wear on the
+    jump's extrapolation, pose and forces from the resolved cycle at the
+    same phase) and marked resolved = 0; they agree with the fully resolved
+    run at the same times."""
+    import csv
+
+    import pyvista
+
+    from meshwear.output.recorder import RunRecorder, summary
+
+    scene = _scene(cases.VALIDATION / "sphere_pin.toml", coefficient=6e-14,
+                   acceleration="cycle_jump", period=0.1, tolerance=0.01)
+    scene = dataclasses.replace(scene, run=dataclasses.replace(scene.run, duration=60.0,
+                                                                 frames=13, history=241))
+    resolved = dataclasses.replace(scene, wear=dataclasses.replace(scene.wear,
+                                                                   acceleration="none"))
+    _, _, ref = run_scene(resolved)
+    model = build_model(scene)
+    recorder = RunRecorder(tmp_path, model)
+    state = run(model, initial_state(model), observers=[recorder])
+    recorder.close(summary(model, state, 0.0))
+    with open(tmp_path / "history.csv") as f:
+        rows = list(csv.DictReader(f))
+    marks = np.array([int(r["resolved"]) for r in rows])
+    resolved_cycles = state.jump.resolved_steps / model.cycle_steps
+    assert resolved_cycles < 0.5 * len(rows)          # outputs force no resolved cycle
+    assert 0 < marks.sum() < len(rows) and marks[0] == 1 and marks[-1] == 1
+    r = ref.rows["ball"]
+    times = np.array([float(row["time"]) for row in rows])
+    np.testing.assert_allclose(times, r["time"], rtol=0, atol=1e-9)
+    volume = np.array([float(row["wear_volume"]) for row in rows])
+    depth = np.array([float(row["max_wear_depth"]) for row in rows])
+    filled_rows = marks == 0
+    volume_error = np.abs(volume - r["wear_volume"])[filled_rows].max() / r["wear_volume"][-1]
+    depth_error = np.abs(depth - r["max_wear_depth"])[filled_rows].max() / r["max_wear_depth"][-1]
+    measured("filled rows: volume error / final", volume_error, 0.0, 1e-2)
+    measured("filled rows: depth error / final", depth_error, 0.0, 1e-2)
+    assert volume_error < 1e-2 and depth_error < 1e-2
+    assert np.all(np.diff(volume) >= 0.0) and np.all(np.diff(depth) >= 0.0)
+    # the pose follows the path at the row's time; the force carries the load
+    x = np.array([float(row["x"]) for row in rows])
+    np.testing.assert_allclose(x, r["origin"][:, 0], rtol=0, atol=1e-9)
+    fz = np.array([float(row["fz"]) for row in rows])
+    np.testing.assert_allclose(fz[1:], r["wrench"][1:, 2], rtol=1e-3)
+    # every frame is written, at its time, and says whether it was resolved
+    series = pyvista.get_reader(tmp_path / "ball.pvd")
+    assert len(series.time_values) == 13
+    frame_marks = []
+    for k in range(13):
+        series.set_active_time_point(k)
+        frame = series.read()[0]
+        frame_marks.append(int(frame.field_data["resolved"][0]))
+        assert frame.point_data["wear_depth"].max() <= depth[-1] * (1 + 1e-12)
+    assert 0 in frame_marks and frame_marks[0] == 1

@@ -306,7 +306,8 @@ def test_reversal_exactly_on_a_step_starts_stick_despite_a_dip_in_load():
 
 @pytest.mark.parametrize("load", [3.0, 0.02, -1.5])
 @pytest.mark.parametrize("opposed", [False, True])
-def test_balance_offset_matches_numpy_twin(load, opposed):
+@pytest.mark.parametrize("scaled", [False, True])
+def test_balance_offset_matches_numpy_twin(load, opposed, scaled):
     """Bracketed Newton against the sorted piecewise-linear solve: a random
     point cloud between planes tilted about the free axis (and, when
     ``opposed``, one facing the other way: g then is not convex)."""
@@ -329,16 +330,20 @@ def test_balance_offset_matches_numpy_twin(load, opposed):
     planes = planes[:1]
     active = np.flatnonzero(np.arange(300) % 3 != 0)
     args = (vertices, pose, axis, planes, vertex_planes, active, params, law, load)
-    expected = reference.balance_offset(*args)
+    # a wear jump scales each vertex's stiffness by 1 / (1 + J alpha_i)
+    scale = 1.0 / (1.0 + rng.uniform(0.0, 30.0, 300)) if scaled else np.zeros(0)
+    expected = reference.balance_offset(*args, scale if scaled else None)
     scratch = np.zeros((2, 600))
     if not opposed and load < 0.0:
         # every plane faces the body from below: nothing can pull it down
         assert np.isnan(expected)
-        assert np.isnan(balance_offset(*args, 0.0, scratch))
+        assert np.isnan(balance_offset(*args, 0.0, scratch, scale))
         return
     for guess in (0.0, -0.05, 0.05, expected):
-        z = balance_offset(*args, guess, scratch)
+        z = balance_offset(*args, guess, scratch, scale)
         assert z == pytest.approx(expected, rel=1e-12, abs=1e-15)
+    if scaled:
+        return
     # the force at the solution is the load
     moved = pose.copy()
     moved[0:3] += z * axis
@@ -368,13 +373,13 @@ def test_balance_offset_refuses_a_load_nothing_can_carry():
     none, one = contact.no_mesh_planes(1), contact.all_vertices(1)
     # a plane under the point carries a load pressing down (contact pushes +z) ...
     assert balance_offset(vertices, pose, up, planes, none, one, FACING_DOWN, law, 2.0, 0.0,
-                          scratch) == pytest.approx(-2e-6)
+                          scratch, np.zeros(0)) == pytest.approx(-2e-6)
     # ... but nothing can pull it down: a load along -z has no carrier
-    assert np.isnan(balance_offset(vertices, pose, up, planes, none, one, FACING_DOWN, law, -2.0, 0.0,
-                                   scratch))
+    assert np.isnan(balance_offset(vertices, pose, up, planes, none, one, FACING_DOWN, law, -2.0,
+                                   0.0, scratch, np.zeros(0)))
     # and a free axis lying in the plane has no normal-force component at all
     assert np.isnan(balance_offset(vertices, pose, np.array([1.0, 0.0, 0.0]), planes, none, one,
-                                   FACING_DOWN, law, 2.0, 0.0, scratch))
+                                   FACING_DOWN, law, 2.0, 0.0, scratch, np.zeros(0)))
 
 
 def test_a_reversal_step_longer_than_the_unloading_slips_again_at_once():

@@ -29,9 +29,11 @@ MAX_ITERATIONS = 200
 
 
 @njit(cache=True)
-def _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law, breakpoint, weight):
-    """Fill ``breakpoint`` (z_j) and ``weight`` (w_j, signed as beta) of every
-    pair that can touch; return how many."""
+def _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law, scale, breakpoint,
+           weight):
+    """Fill ``breakpoint`` (z_j) and ``weight`` (w_j, signed as beta, times
+    ``scale[i]`` of its vertex if ``scale`` is not empty) of every pair that
+    can touch; return how many."""
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
     c0, c1 = law[5], law[6]
     n_planes = planes.shape[0]
@@ -60,6 +62,8 @@ def _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law, 
             delta = (px - plane[0, 0]) * nx + (py - plane[0, 1]) * ny + (pz - plane[0, 2]) * nz
             breakpoint[count] = -delta / beta
             weight[count] = c * beta * beta * (1.0 if beta > 0.0 else -1.0)
+            if scale.shape[0]:
+                weight[count] *= scale[i]
             count += 1
     return count
 
@@ -80,9 +84,11 @@ def _force(z, breakpoint, weight, count):
 
 @njit(cache=True)
 def balance_offset(body_vertices, pose, axis, planes, vertex_planes, active, area, law, load,
-                   guess, scratch):
+                   guess, scratch, scale):
     """Offset ``z`` (m) along ``axis`` at which the contact normal forces on
-    the body at ``pose`` add up to ``load`` (N) along ``axis``.
+    the body at ``pose`` add up to ``load`` (N) along ``axis``; with a
+    non-empty ``scale`` (n,), the contact stiffness of vertex ``i`` times
+    ``scale[i]`` (a wear jump: :mod:`meshwear.wear`).
 
     Returns NaN when no contact can push the way ``load`` needs (no plane
     faces the body along the axis, or the load pulls it away from every
@@ -93,7 +99,7 @@ def balance_offset(body_vertices, pose, axis, planes, vertex_planes, active, are
     (the faces under the vertices before the move).
     """
     breakpoint, weight = scratch[0], scratch[1]
-    count = _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law,
+    count = _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law, scale,
                    breakpoint, weight)
     # the side that must carry the load: pairs pushing along +axis for a
     # positive load (beta > 0), along -axis for a negative one

@@ -114,6 +114,7 @@ def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, 
     plane_array = planes[0]
     rotation, frame = np.zeros((3, 3)), np.zeros((4, 3))
     placed = np.zeros(13)
+    no_scale = np.zeros(0)
     if (quasi_static and kind == BALANCED
             and scratch.shape[1] < active.shape[0] * (plane_array.shape[0] + vertex_planes.shape[0])):
         return k, REFRESH                # Python grows the scratch
@@ -148,7 +149,7 @@ def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, 
         _fill(body, planes, surfaces, t, buffer, rotation, frame)
         if kind == BALANCED:
             z = balance_offset(vertices, pose, params[AXIS], plane_array, vertex_planes, active,
-                               area, law, params[CARRIED], 0.0, scratch)
+                               area, law, params[CARRIED], 0.0, scratch, no_scale)
             if not np.isfinite(z):
                 return k, NO_BALANCE
             for j in range(3):

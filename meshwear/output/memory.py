@@ -22,7 +22,7 @@ class MemoryHistory:
             q = body_quantities(body, s, model)
             r = self._rows.setdefault(body.name, {k: [] for k in (
                 "time", "pose", "origin", "wrench", "friction_work", "wear_volume",
-                "max_wear_depth", "wear_depth", "contact_points", "active")})
+                "max_wear_depth", "wear_depth", "contact_points", "active", "resolved")})
             r["time"].append(state.time)
             r["pose"].append(s.pose.copy())
             r["origin"].append(q["origin"])
@@ -33,6 +33,7 @@ class MemoryHistory:
             r["wear_depth"].append(s.wear_depth.copy())
             r["contact_points"].append(int((q["contact_state"] > 0).sum()))
             r["active"].append(len(s.active))
+            r["resolved"].append(bool(state.resolved))
 
     def on_frame(self, model, state):
         pass

@@ -12,7 +12,8 @@ from .tables import HISTORY_COLUMNS, HistoryWriter, write_json_atomic
 from .vtk import PVDSeries
 
 #: columns added to DESIGN.md §5's history.csv (extend, never rename)
-EXTRA_COLUMNS = ("wx", "wy", "wz", "tx", "ty", "tz", "contact_points", "stick_points", "slip_points")
+EXTRA_COLUMNS = ("wx", "wy", "wz", "tx", "ty", "tz", "contact_points", "stick_points", "slip_points",
+                 "resolved")
 FIELDS = ("wear_depth", "normal_force", "friction_force", "pressure", "contact_state", "friction_work")
 
 
@@ -59,13 +60,14 @@ class RunRecorder:
             row.update(time=state.time, body=body.name, friction_work=q["total_friction_work"],
                        wear_volume=q["wear_volume"], max_wear_depth=q["max_wear_depth"],
                        contact_points=int((states > 0).sum()), stick_points=int((states == 1).sum()),
-                       slip_points=int((states == 2).sum()))
+                       slip_points=int((states == 2).sum()), resolved=int(state.resolved))
             self.history.write(row)
 
     def on_frame(self, model, state):
         for body, s in zip(model.bodies, state.bodies):
             q = body_quantities(body, s, model)
-            self.series[body.name].write_frame(state.time, q["points"], {k: q[k] for k in FIELDS})
+            self.series[body.name].write_frame(state.time, q["points"], {k: q[k] for k in FIELDS},
+                                               {"resolved": int(state.resolved)})
         for surface, vertices, series in self.moving.values():
             series.write_frame(state.time, surface.world_vertices(vertices, state.time), {})
 
@@ -98,6 +100,7 @@ def summary(model, state, wall_time, status="ok", message=None):
         out["jumps"] = state.jump.jumps
         out["error_estimate"] = error_estimate(state)
         out["jump_limits"] = dict(state.jump.limits)
+        out["jump_method"] = model.scene.wear.jump
     if message:
         out["message"] = message
     for body, s in zip(model.bodies, state.bodies):

@@ -52,7 +52,7 @@ class PVDSeries:
         self._closed = False
         self._write_pvd()           # an empty collection replaces any older series
 
-    def write_frame(self, time, points, point_data):
+    def write_frame(self, time, points, point_data, field_data=None):
         """Write one frame and list it in the ``.pvd``.
 
         Parameters
@@ -63,6 +63,9 @@ class PVDSeries:
             World coordinates (m).
         point_data : dict of str -> (n,) or (n, k) array
             Scalars or vectors per point; bool is stored as uint8.
+        field_data : dict of str -> scalar or array, optional
+            Values for the whole frame (``resolved``: 0 for a frame filled
+            from a cycle jump).
 
         Returns
         -------
@@ -88,6 +91,8 @@ class PVDSeries:
                                  f"or ({len(points)}, k)")
             mesh.point_data[key] = np.ascontiguousarray(value)
         mesh.field_data["TimeValue"] = np.array([float(time)])   # read by ParaView for a lone frame
+        for key, value in (field_data or {}).items():
+            mesh.field_data[key] = np.atleast_1d(np.asarray(value))
         index = len(self._entries)
         relative = f"{self.name}/{self.name}_{index:05d}.vtp"
         path = self.out_dir / relative

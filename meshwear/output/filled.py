@@ -1,0 +1,127 @@
+"""Outputs inside a jumped span, filled from the jump (docs/outputs.md, "Long runs").
+
+A history row or frame whose time falls in cycles a jump skips costs no
+resolved cycle. While the cycle before a jump is resolved, the state of each
+body is recorded at the phases of the outputs the jump may cover
+(:func:`record`); once the jump is taken, each such output is written
+(:func:`write`) from a view of the state: wear depth, worn volume, friction
+work and the worn vertices interpolated along the jump, the pose and the
+contact forces those of the resolved cycle at the same phase (the pose put
+on its path at the output's time, a guided body moved along its axis by the
+jump's share). The rows and frames are marked ``resolved = 0``.
+"""
+
+import copy
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..kernels.contact import FORCE
+
+
+@dataclass
+class Snapshot:
+    """One body's state at one phase of the resolved cycle: pose, contact
+    wrench, contact states and, for frames, the forces and the surfaces'
+    normals under the vertices (for the pressure)."""
+
+    pose: np.ndarray
+    wrench: np.ndarray
+    contact_state: np.ndarray
+    normal_force: np.ndarray = None
+    friction_force: np.ndarray = None
+    normals: np.ndarray = None
+
+
+def _capture(state, frame):
+    out = []
+    for s in state.bodies:
+        shot = Snapshot(s.pose.copy(), s.wrench.copy(), s.contact_state.copy())
+        if frame:
+            shot.normal_force = s.normal_force.copy()
+            shot.friction_force = s.tangential[:, :, FORCE].copy()
+            shot.normals = s.vertex_planes[:, :, 1].copy()
+        out.append(shot)
+    return out
+
+
+def phases(model, start, stop, cycles):
+    """The outputs a jump of up to ``cycles`` after the cycle ``start..stop``
+    could cover, as ``{step of this cycle: any of them a frame}``; the step
+    of this cycle is the one at the same phase (``stop`` for phase 0)."""
+    n_c = stop - start
+    schedule = model.output_steps
+    inside = schedule[(schedule > stop) & (schedule < stop + cycles * n_c)]
+    out = {}
+    for o in inside.tolist():
+        phase = (o - start) % n_c
+        r = start + phase if phase else stop
+        out[r] = out.get(r, False) or o in model.frame_set
+    return out
+
+
+def record(model, state, start, stop, cycles, observers, progress, compiled):
+    """Resolve the cycle ``start..stop`` (writing its own outputs), keeping
+    the snapshots a jump of up to ``cycles`` cycles after it needs."""
+    from ..simulate import advance
+
+    wanted = phases(model, start, stop, cycles)
+    snapshots = {}
+    for r in sorted(wanted) + [stop]:
+        advance(model, state, r, observers, progress, compiled=compiled)
+        if r in wanted:
+            snapshots[r - start] = _capture(state, wanted[r])
+    return snapshots
+
+
+def write(model, state, stop, jump, snapshots, spans, observers):
+    """Write every output strictly inside the span the jump just covered
+    (``stop`` to ``stop + jump`` cycles), filled from it (``spans``: per body,
+    the jumped arrays at its start and end, and the shift of its position)."""
+    from ..simulate import check
+
+    n_c = model.cycle_steps
+    end = stop + jump * n_c
+    schedule = model.output_steps
+    start = stop - n_c
+    for o in schedule[(schedule > stop) & (schedule < end)].tolist():
+        phase = (o - start) % n_c
+        shots = snapshots[phase if phase else n_c]
+        fraction = (o - stop) / (end - stop)
+        view = copy.copy(state)
+        view.step, view.time = o, o * model.dt
+        view.bodies = [_view(body, s, shot, span, fraction, view.time)
+                       for body, s, shot, span in zip(model.bodies, state.bodies, shots, spans)]
+        sample, frame = o in model.sample_set, o in model.frame_set
+        if frame:
+            check(model, view, [b.reference_face_normals for b in model.bodies])
+        for observer in observers:
+            if sample:
+                observer.on_sample(model, view)
+            if frame:
+                observer.on_frame(model, view)
+        state.written = o
+
+
+def _view(body, s, shot, span, fraction, t):
+    """A body state at ``fraction`` of the jump, with the contact of ``shot``."""
+    view = copy.copy(s)
+    view.pose = shot.pose.copy()
+    view.pose[0:3] += fraction * span["shift"]
+    body.motion.place(view.pose, t)
+    view.wrench = shot.wrench
+    view.contact_state = shot.contact_state
+    for name, value in span.items():
+        if name != "shift":
+            first, last = value
+            setattr(view, name, first + fraction * (last - first))
+    if shot.normal_force is not None:
+        view.normal_force = shot.normal_force
+        view.tangential = np.zeros_like(s.tangential)
+        view.tangential[:, :, FORCE] = shot.friction_force
+        view.vertex_planes = np.zeros_like(s.vertex_planes)
+        view.vertex_planes[:, :, 1] = shot.normals
+    else:
+        view.normal_force = np.zeros_like(s.normal_force)
+        view.tangential = np.zeros_like(s.tangential)
+    return view
