@@ -55,6 +55,9 @@ def save(path, model, state, wall_time):
             arrays[f"jump{k}_error"] = error
             if rate is not None:
                 arrays[f"jump{k}_rate"] = rate
+        for k, alpha in enumerate(js.alpha):
+            if alpha is not None:
+                arrays[f"jump{k}_alpha"] = alpha
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
@@ -120,6 +123,8 @@ def load(path, model, state):
             rate=[data[f"jump{k}_rate"].copy() if f"jump{k}_rate" in data else None
                   for k in range(n)],
             error=[data[f"jump{k}_error"].copy() for k in range(n)],
+            alpha=[data[f"jump{k}_alpha"].copy() if f"jump{k}_alpha" in data else None
+                   for k in range(n)],
             gap=float(gap), last_jump=int(last), jumps=int(jumps), resolved_steps=int(resolved),
             settling=bool(settling), limits=limits)
     return float(wall)

@@ -141,8 +141,8 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0):
 def _check(scene_path):
     import numpy as np
 
+    from . import stepper
     from .model import initial_state
-    from .simulate import step
 
     scene, model, limit = _prepare(scene_path)
     print(f"scene {scene.source}: ok (format 1, mode {scene.run.mode})")
@@ -160,15 +160,15 @@ def _check(scene_path):
     if model.cycle_steps:
         cycles = model.n_steps / model.cycle_steps
         print(f"  cycle jumping: {model.cycle_steps} steps per cycle, {cycles:.6g} cycles, "
-              f"tolerance {scene.wear.tolerance:g}; at least {len(model.output_steps)} cycles "
-              "are resolved (one per output)")
+              f"{scene.wear.jump} jumps, tolerance {scene.wear.tolerance:g}; outputs inside "
+              "jumps are filled from them")
     state = initial_state(model)
-    step(model, state)  # compile (or load the cached) kernels
-    trial = min(model.n_steps, 200)
+    warm = 1 if model.n_steps > 1 else 0
+    stepper.advance(model, state, warm)  # compile (or load the cached) kernels
+    trial = min(model.n_steps - warm, 200)
     start = time.perf_counter()
-    for _ in range(trial):
-        step(model, state)
-    per_step = (time.perf_counter() - start) / max(trial, 1)
+    stepper.advance(model, state, warm + trial)
+    per_step = max(time.perf_counter() - start, 1e-9) / max(trial, 1)
     active = sum(len(s.active) for s in state.bodies)
     total = sum(len(b.tributary_area) for b in model.bodies)
     points = active * max(1, model.slots)

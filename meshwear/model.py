@@ -162,9 +162,9 @@ class BodyState:
     active_wear: np.ndarray = None
     cull: np.ndarray = None
     cull_scratch: object = None
-    #: (n,) each vertex's largest total normal force since it was last
-    #: zeroed (N), kept while cycles are jumped over; empty otherwise
-    peak: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: (n,) each vertex's total normal force added up over the steps since
+    #: it was last zeroed (N), kept while cycles are jumped over; else empty
+    load: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass(eq=False)

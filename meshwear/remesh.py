@@ -13,9 +13,13 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=5_000_000):
     """Split triangles until every edge of the selected faces is <= ``resolution``.
 
     Conforming longest-edge bisection (Rivara): a face that needs refining has
-    its longest edge split; a face that shares a split edge has its own longest
-    edge split too (closure), then each face is cut along its split edges. No
-    T-junctions are left, so a closed mesh stays closed. After each pass,
+    its longest edge split; a selected face that shares a split edge has its
+    own longest edge split too (closure), then each face is cut along its split
+    edges. An unselected face with one split edge is cut along it, towards its
+    opposite corner, and nothing more: the refinement does not grade into the
+    faces that cannot touch (a block's side walls keep tall triangles next to
+    its worn face, which the wear of that face cannot invert). No T-junctions
+    are left, so a closed mesh stays closed. After each pass,
     Delaunay edge flips between coplanar selected faces keep the triangles well
     shaped, so a long thin CAD triangle costs about what a well-shaped face of
     the same area does. The surface itself never changes.
@@ -54,8 +58,12 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=5_000_000):
         rows = np.arange(len(F))
         marked = np.zeros(len(edges), bool)
         marked[eid[need, longest[need]]] = True
-        while True:  # closure: a face with any split edge has its longest edge split too
-            bad = marked[eid].any(axis=1) & ~marked[eid[rows, longest]]
+        while True:
+            # closure: a selected face with any split edge has its longest
+            # edge split too (Rivara); an unselected one only when two of its
+            # edges are split: with one, it is cut along that edge (green)
+            count = marked[eid].sum(axis=1)
+            bad = (count > (~mask).astype(np.int64)) & ~marked[eid[rows, longest]]
             if not bad.any():
                 break
             marked[eid[bad, longest[bad]]] = True
@@ -72,14 +80,17 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=5_000_000):
 
 
 def _bisect(F, mask, eid, midpoint, marked, longest):
-    """Cut every face along its marked edges (the longest one first).
+    """Cut every face along its marked edges (the longest one first; an
+    unselected face with one marked edge along that edge).
 
     Returns the new faces, their mask and the index of the first new face
     (uncut faces come first, unchanged).
     """
     rows = np.arange(len(F))
-    cut = marked[eid[rows, longest]]
-    k = longest[cut]
+    has = marked[eid]
+    first = np.where(has[rows, longest], longest, has.argmax(axis=1))
+    cut = has.any(axis=1)
+    k = first[cut]
     f, e = F[cut], eid[cut]
     r = np.arange(len(f))
     a, b, c = f[r, k], f[r, (k + 1) % 3], f[r, (k + 2) % 3]

@@ -77,11 +77,11 @@ def finish_step(model, body, s, t):
 
 
 def touch(model, body, s):
-    """One step of the contact kernel, and the peak normal forces if kept."""
+    """One step of the contact kernel, and the normal forces added to ``s.load`` if kept."""
     body_contact(model, body, s)
-    if len(s.peak):
+    if len(s.load):
         a = s.active
-        s.peak[a] = np.maximum(s.peak[a], s.normal_force[:, a].sum(axis=0))
+        s.load[a] += s.normal_force[:, a].sum(axis=0)
 
 
 def no_balance(body, t):

@@ -5,36 +5,25 @@ vertex's wear in that cycle, extrapolate it over ``J`` cycles, then resolve
 again. The extrapolation (``wear.jump``) is
 
 implicit (default)
-    a backward-Euler step: a vertex's wear rate is proportional to its
-    elastic penetration ``p_i`` (Winkler: pressure is linear in penetration,
-    and Archard's or the energy law in pressure), ``r_i = alpha_i p_i``, and
-    the jump solves ``w_i = J alpha_i p_i(end)`` with ``p_i(end) = p_i - beta_i z
-    - w_i``, ``z`` the move of a guided body along its free axis that keeps its
-    load carried by the relieved contacts (the quasi-static balance,
-    :func:`meshwear.kernels.balance.balance_offset`, with each vertex's
-    stiffness divided by ``1 + J alpha_i``). Each vertex's pressure relaxes
-    by ``1 / (1 + J alpha_i)`` instead of ``exp(-J alpha_i)``: stable for any
-    ``J``, exact for long ones where the pressure has settled.
+    a backward-Euler step in which each vertex's pressure is relieved by its
+    own wear and a guided body's load re-balanced (:mod:`meshwear.jumps`):
+    stable for any ``J``. ``J`` is the largest one whose error, estimated by
+    step doubling (one jump of ``J`` against two of ``J / 2``) and by the
+    drift of the wear per unit penetration between resolved cycles, stays
+    under ``tolerance`` times the depth the jump adds where wear is fastest;
 explicit
-    the cycle's wear times ``J``, with the stability bound below.
+    the cycle's wear times ``J``, ``J`` bounded by the slope criterion (the
+    change of each vertex's wear rate between the last two resolved cycles,
+    ``rho`` per cycle, makes the extrapolation wrong by about ``rho J^2 / 2``)
+    and for stability (no vertex may wear by more than a fraction
+    :data:`THETA` of its elastic penetration in one jump: past that the
+    extrapolated wear opens a gap where the contact carried load, and the worn
+    profile oscillates from jump to jump while the worn volume looks right).
 
-``J`` is chosen before every jump from
-
-accuracy (slope criterion)
-    the change of each vertex's wear rate between the last two resolved
-    cycles, ``rho`` per cycle, makes the extrapolation over ``J`` cycles
-    wrong by about ``rho J^2 / 2``; ``J`` keeps that under ``tolerance`` times
-    the depth the jump adds where wear is fastest, so the errors of all jumps
-    add up to at most ``tolerance`` times the deepest wear.
-growth
-    ``J`` grows by at most a factor :data:`GROWTH` from one jump to the next.
-stability (explicit jumps only)
-    no vertex may wear by more than a fraction :data:`THETA` of its elastic
-    penetration in one jump. Past that the extrapolated wear opens a gap where
-    the contact was carrying load, and the worn profile oscillates from jump
-    to jump while the worn volume still looks right.
-
-Outputs falling inside a jumped span are filled from the jump
+Either way ``J`` grows by at most a factor :data:`GROWTH` from one jump to
+the next, the errors of all jumps add up to at most ``tolerance`` times the
+deepest wear (the summary's ``error_estimate``), and the run ends with a
+resolved cycle. Outputs falling inside a jumped span are filled from the jump
 (:mod:`meshwear.output.filled`), so they cost no resolved cycle. In the
 dynamic mode the cycle after a jump only lets the contact settle and the
 next one is measured.
@@ -44,9 +33,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .kernels.balance import balance_offset
+from . import jumps
 from .kernels.contact import ANCHOR
-from .motion import BalancedMotion, GuidedMotion
 from .output import filled
 from .surfaces import contact_areas, quaternion_matrix, slot_normals
 
@@ -70,8 +58,9 @@ class JumpState:
     resolved_steps: int = 0
     error: list = field(default_factory=list)      # per body (n,) estimated error of w (m)
     settling: bool = False                          # dynamic: the next cycle only settles
-    limits: dict = field(default_factory=lambda: {"stability": 0, "accuracy": 0, "growth": 0,
-                                                   "end": 0})
+    alpha: list = field(default_factory=list)      # per body (n,) implicit: wear per cycle per
+                                                    # unit penetration, last measured (0: none)
+    limits: dict = field(default_factory=lambda: {"accuracy": 0, "growth": 0, "end": 0})
 
 
 def penetration(model, body, s):
@@ -84,18 +73,6 @@ def penetration(model, body, s):
         loaded = (s.normal_force[j] > 0.0) & (c > 0.0)
         out[loaded] = np.maximum(out[loaded], s.normal_force[j][loaded] / c[loaded])
     return out
-
-
-def cycle_penetration(model, body, s, pressed=None):
-    """(n,) the penetration a vertex's wear in the last cycle answers to: its
-    elastic penetration at the end of the cycle (``pressed``, computed if not
-    given) or, for a vertex that touched during the cycle only, its peak
-    normal force over its stiffness."""
-    if pressed is None:
-        pressed = penetration(model, body, s)
-    c = model.law[5] + model.law[6] * body.area_vectors[:, 3]
-    peak = np.where(c > 0.0, s.peak / np.where(c > 0.0, c, 1.0), 0.0)
-    return np.where(pressed > 0.0, pressed, peak)
 
 
 def choose_jump(rate, previous, gap, penetration_, tolerance, last_jump, limit, theta=THETA,
@@ -153,17 +130,18 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
     implicit = model.scene.wear.jump == "implicit"
     if state.jump is None:
         state.jump = JumpState(rate=[None] * len(model.bodies),
-                               error=[np.zeros(len(b.tributary_area)) for b in model.bodies])
+                               error=[np.zeros(len(b.tributary_area)) for b in model.bodies],
+                               alpha=[None] * len(model.bodies))
     js = state.jump
     for body, s in zip(model.bodies, state.bodies):
-        if len(s.peak) != len(s.wear_depth):
-            s.peak = np.zeros(len(s.wear_depth))
+        if len(s.load) != len(s.wear_depth):
+            s.load = np.zeros(len(s.wear_depth))
     while state.step < model.n_steps:
         start = state.step
         before = [(s.wear_depth.copy(), s.vertices.copy(), s.wear_volume.copy(),
                    s.friction_work.copy()) for s in state.bodies]
         for s in state.bodies:
-            s.peak[:] = 0.0
+            s.load[:] = 0.0
         stop = min(start + n_c, model.n_steps)
         # the cycles a jump after this one may cover: the outputs in them are
         # filled from the states of this cycle at the same phase
@@ -179,113 +157,103 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
             js.settling = False
             continue
         rates = [s.wear_depth - b[0] for s, b in zip(state.bodies, before)]
-        jump, which = end_limit, "end"
-        if forced_jump is not None:
-            jump, which = min(end_limit, forced_jump), "forced"
+        measures = ([jumps.measure(model, body, s, rate, stop - start)
+                     for body, s, rate in zip(model.bodies, state.bodies, rates)]
+                    if implicit else None)
+        if implicit:
+            jump, which, results = _choose_implicit(measures, rates, js, end_limit, could,
+                                                    tolerance, forced_jump)
         else:
-            for body, s, rate, previous in zip(model.bodies, state.bodies, rates, js.rate):
-                j, w = choose_jump(rate, previous, js.gap, penetration(model, body, s),
-                                   tolerance, js.last_jump, end_limit, stability=not implicit)
-                if j < jump:
-                    jump, which = j, w
-        jump = min(jump, could)
+            jump, which = end_limit, "end"
+            if forced_jump is not None:
+                jump, which = min(end_limit, forced_jump), "forced"
+            else:
+                for body, s, rate, previous in zip(model.bodies, state.bodies, rates, js.rate):
+                    j, w = choose_jump(rate, previous, js.gap, penetration(model, body, s),
+                                       tolerance, js.last_jump, end_limit)
+                    if j < jump:
+                        jump, which = j, w
+            jump = min(jump, could)
+            results = [(jump * rate, 0.0, _slope_error(rate, previous, js.gap, jump))
+                       for rate, previous in zip(rates, js.rate)]
         if jump > 0:
-            # the slope criterion's own estimate of this jump's error, per vertex
-            for error, rate, previous in zip(js.error, rates, js.rate):
-                if previous is not None:
-                    error += 0.5 * np.abs(rate - previous) / max(js.gap, 1.0) * jump * jump
+            for error, (_, _, estimate) in zip(js.error, results):
+                error += estimate
             js.limits[which] = js.limits.get(which, 0) + 1
-            spans = _jump(model, state, before, rates, jump, implicit)
+            spans = _jump(model, state, before, rates, jump, results, measures)
             filled.write(model, state, stop, jump, snapshots, spans, observers)
             js.jumps += 1
             js.settling = not model.quasi_static
         js.last_jump = jump
         js.rate = rates
+        if implicit:
+            js.alpha = [np.where(m.mean > 0.0, m.alpha, 0.0) for m in measures]
         js.gap = jump + 1.0 + (1.0 if js.settling else 0.0)
         if checkpoint is not None:
             checkpoint(model, state)
     return state
 
 
-def _implicit(model, body, s, rate, jump):
-    """Backward-Euler wear of one body over ``jump`` cycles: (n,) wear and
-    the move ``z`` (m) along a guided body's free axis.
-
-    Three kinds of vertices: pressed at the end of the cycle (their
-    penetration answers to ``z``), touched during the cycle only (a gear
-    flank: their peak penetration bounds their wear, ``z`` aside), and
-    untouched ones that ``z`` may bring into contact (they wear as the
-    contact does on average per unit penetration, their own rate unknown).
-    A pressed vertex that did not wear (it sticks) keeps ``alpha = 0``.
-    """
-    pressed = penetration(model, body, s)
-    pen = cycle_penetration(model, body, s, pressed)
-    wearing = (rate > 0.0) & (pen > 0.0)
-    alpha = np.zeros(len(rate))
-    alpha[wearing] = rate[wearing] / pen[wearing]
-    fresh = pen <= 0.0
-    area = body.area_vectors[:, 3]
-    if wearing.any():
-        alpha[fresh] = (rate[wearing] @ area[wearing]) / (pen[wearing] @ area[wearing])
-    relief = 1.0 / (1.0 + jump * alpha)
-    depth = pen
-    z, beta, normal = 0.0, np.zeros(len(rate)), None
-    motion = body.motion
-    if isinstance(motion, (BalancedMotion, GuidedMotion)) and len(s.active):
-        axis = motion.axis
-        carried = (motion.carried if isinstance(motion, BalancedMotion)
-                   else -float(motion.params[19:22] @ axis) / motion.params[0])
-        scratch = np.zeros((2, len(s.active) * model.slots))
-        z = balance_offset(s.vertices, s.pose, axis, model.planes, s.vertex_planes, s.active,
-                           body.area_vectors, model.law, carried, 0.0, scratch, relief)
-        if not np.isfinite(z):
-            z = 0.0
-        gap, normal = _nearest(model, body, s)
-        moves = (pressed > 0.0) | fresh
-        depth = np.where(fresh, gap, pen)
-        beta = np.where(moves, normal @ axis, 0.0)
-    return jump * alpha * np.maximum(0.0, depth - beta * z) * relief, z, normal
+def _slope_error(rate, previous, gap, jump):
+    """(n,) the slope criterion's estimate of an explicit jump's error (m)."""
+    if previous is None:
+        return np.zeros(len(rate))
+    return 0.5 * np.abs(rate - previous) / max(gap, 1.0) * jump * jump
 
 
-def _nearest(model, body, s):
-    """Per vertex, the penetration ``-Delta`` (m, negative: a gap) on the
-    surface it is nearest to or deepest in, and that surface's normal there
-    (world; zero where no surface faces it)."""
-    from .kernels.contact import FACING
+def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None):
+    """Cycles to jump over with implicit jumps, which bound set it, and per
+    body the jump's ``(wear, move, error estimate)``.
 
-    R = quaternion_matrix(s.pose[3:7])
-    x = s.pose[0:3] + s.vertices @ R.T
-    world = body.area_vectors[:, 0:3] @ R.T
-    n_vertices = len(x)
-    best, nearest = np.full(n_vertices, -np.inf), np.zeros((n_vertices, 3))
-    rows = [np.broadcast_to(p[0:2], (n_vertices, 2, 3)) for p in model.planes]
-    rows += [vp[:, 0:2] for vp in s.vertex_planes]
-    for row in rows:
-        point, normal = row[:, 0], row[:, 1]
-        facing = -np.einsum("ij,ij->i", world, normal) > FACING * body.area_vectors[:, 3]
-        depth = -np.einsum("ij,ij->i", x - point, normal)
-        better = facing & (depth > best)
-        best[better] = depth[better]
-        nearest[better] = normal[better]
-    return best, nearest
+    Bounds: ``end`` (the run ends with a resolved cycle), ``could`` (the
+    growth bound the snapshots were taken for, or a forced jump), the drift
+    of each vertex's wear per unit penetration between the last two
+    measurements (``rho_alpha pbar J^2 / 2 <= tol J r_max``), and step
+    doubling (the jump's estimated error ``<= tol J r_max``)."""
+    fastest = max(float(r.max()) if len(r) else 0.0 for r in rates)
+    if forced is not None:
+        jump = min(end, could)
+        return jump, "forced", [jumps.implicit(m, jump) for m in measures]
+    if fastest <= 0.0 or any(a is None for a in js.alpha):
+        return 0, "accuracy", None
+    bounds = {"end": float(end), "growth": float(could)}
+    drift = 0.0
+    for m, previous in zip(measures, js.alpha):
+        both = (m.mean > 0.0) & (previous > 0.0) & (m.alpha > 0.0)
+        if both.any():
+            rho = np.abs(m.alpha[both] - previous[both]) / max(js.gap, 1.0)
+            drift = max(drift, float((rho * m.mean[both]).max()))
+    if drift > 0.0:
+        bounds["drift"] = 2.0 * tolerance * fastest / drift
+    which = min(bounds, key=bounds.get)
+    jump = int(np.floor(bounds[which]))
+    for _ in range(12):
+        if jump < 1:
+            return 0, "accuracy", None
+        results = [jumps.implicit(m, jump) for m in measures]
+        worst = max(float(e.max()) for _, _, e in results) / (tolerance * jump * fastest)
+        if worst <= 1.0:
+            return jump, which, results
+        # the error grows like J^2, its allowance like J
+        jump, which = int(jump * min(0.9 / worst, 0.5 if worst > 2.0 else 0.9)), "accuracy"
+    return 0, "accuracy", None
 
 
 #: the per-vertex arrays a jump extrapolates
 JUMPED = ("vertices", "wear_depth", "wear_volume", "friction_work")
 
 
-def _jump(model, state, before, rates, jump, implicit):
-    """Extrapolate the last resolved cycle over ``jump`` more cycles; return
-    per body ``{name: (array at the jump's start, at its end)}`` for the
-    :data:`JUMPED` arrays, and ``shift``, the move of its position."""
+def _jump(model, state, before, rates, jump, results, measures=None):
+    """Extrapolate the last resolved cycle over ``jump`` more cycles, each
+    body's wear and move along its axis given by ``results``; return per body
+    ``{name: (array at the jump's start, at its end)}`` for the :data:`JUMPED`
+    arrays, and ``shift``, the move of its position."""
     spans = []
-    for body, s, b, rate in zip(model.bodies, state.bodies, before, rates):
+    for k, (body, s, b, rate) in enumerate(zip(model.bodies, state.bodies, before, rates)):
         _, vertices0, volume0, work0 = b
         span = {name: getattr(s, name).copy() for name in JUMPED}
-        if implicit:
-            wear, z, normal = _implicit(model, body, s, rate, jump)
-        else:
-            wear, z, normal = jump * rate, 0.0, None
+        wear, z, _ = results[k]
+        normal = measures[k].normal if measures is not None else None
         # every increment of the cycle scaled like the vertex's wear: a
         # vertex relieved by the jump wears, and dissipates, less
         factor = np.full(len(rate), float(jump))
@@ -297,7 +265,7 @@ def _jump(model, state, before, rates, jump, implicit):
         s.wear_volume += factor * volume
         s.friction_work += factor * work
         fresh = ~wearing & (wear > 0.0)
-        if fresh.any():
+        if fresh.any() and normal is not None:
             # a vertex the jump brought into contact had no cycle to scale:
             # it moves along its surface's normal, wears its depth times its
             # contact area, and dissipates what the contact does per volume

@@ -119,7 +119,7 @@ INVERTING = """\
 format = 1
 
 [run]
-duration = 0.02
+duration = 0.06
 dt = 5e-6
 frames = 11
 history = 21
@@ -556,8 +556,9 @@ def test_wear_through_the_thickness_stops_with_exit_3_and_valid_outputs(tmp_path
     summary = json.loads((out_dir / "summary.json").read_text())
     assert summary["status"] == "numerical_error"
     assert "inverted" in summary["message"]
-    assert 0.0 < summary["time"] < 0.02
-    assert summary["steps"] < 4000
+    # about 0.3 mm of wear every 0.02 s: through the 0.5 mm plate by 0.04 s
+    assert 0.02 < summary["time"] < 0.06
+    assert summary["steps"] < 12000
 
     entries = pvd_entries(out_dir / "plate.pvd")
     assert 1 <= len(entries) < 11
@@ -734,5 +735,6 @@ def test_check_of_a_cycle_jumping_scene_says_how_it_jumps(capsys, caplog):
     scene = Path(__file__).parents[1] / "examples" / "long" / "sphere_fretting_1e5.toml"
     code, out, err = cli(capsys, caplog, "check", scene)
     assert code == 0, err
-    assert "cycle jumping: 20 steps per cycle, 100000 cycles, tolerance 0.01" in out
+    assert ("cycle jumping: 20 steps per cycle, 100000 cycles, implicit jumps, tolerance 0.01; "
+            "outputs inside jumps are filled from them") in out
     assert "if every cycle were resolved" in out

@@ -14,9 +14,9 @@ Arguments are grouped in tuples (:mod:`meshwear.stepper` packs them):
 body
     ``vertices, pose, area, law, wear_direction, contact_state, tangential,
     normal_force, friction_work, wear_depth, wear_volume, wrench,
-    vertex_planes, hint, active, active_wear, cull, distance, peak`` (the
-    arrays of :class:`meshwear.model.BodyState` and its model; ``peak`` (n,)
-    keeps each vertex's largest total normal force, or is empty) and
+    vertex_planes, hint, active, active_wear, cull, distance, load`` (the
+    arrays of :class:`meshwear.model.BodyState` and its model; ``load`` (n,)
+    adds up each vertex's total normal force over the steps, or is empty) and
     ``radius`` (m).
 motion
     ``kind`` and ``params`` (:mod:`meshwear.kernels.rigid`), the path
@@ -62,10 +62,10 @@ def _fill(body, planes, surfaces, t, buffer, rotation, frame):
 
 @njit(cache=True)
 def _touch(body, plane_array):
-    """One step of the contact kernel; the peak normal forces."""
+    """One step of the contact kernel; the normal forces added to ``load``."""
     (vertices, pose, area, law, wear_direction, contact_state, tangential, normal_force,
      friction_work, wear_depth, wear_volume, wrench, vertex_planes, hint, active, active_wear,
-     cull, distance, peak, radius) = body
+     cull, distance, load, radius) = body
     slots = plane_array.shape[0] + vertex_planes.shape[0]
     if active.shape[0] * slots >= PARALLEL_THRESHOLD:
         contact_parallel(vertices, pose, plane_array, vertex_planes, active, area, law,
@@ -75,14 +75,13 @@ def _touch(body, plane_array):
         contact_serial(vertices, pose, plane_array, vertex_planes, active, area, law,
                        wear_direction, contact_state, tangential, normal_force, friction_work,
                        wear_depth, wear_volume, wrench)
-    if peak.shape[0]:
+    if load.shape[0]:
         for k in range(active.shape[0]):
             i = active[k]
             total = 0.0
             for s in range(slots):
                 total += normal_force[s, i]
-            if total > peak[i]:
-                peak[i] = total
+            load[i] += total
 
 
 @njit(cache=True)

@@ -152,7 +152,7 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
         best = kept = -1
         best_d2 = kept_d2 = np.inf
         best_delta = kept_delta = -np.inf
-        lo, hi = _cell_range(yx, yy, yz, grid, keys, starts)
+        lo, hi = 0, -1
         h = hint[i]
         if tracked and h >= 0:
             # still over the face it had, within reach and TRACKING: it stays
@@ -164,7 +164,8 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             if (delta * delta <= reach2 and outside <= over
                     and _along(frames, h, 0, tx, ty, tz) + frames[h, 0, 3] >= TRACKING):
                 kept, kept_d2, kept_delta = h, delta * delta, delta
-                lo = hi
+        if kept < 0:
+            lo, hi = _cell_range(yx, yy, yz, grid, keys, starts)
         for j in range(lo, hi):
             f = items[j]
             delta = _along(frames, f, 0, yx, yy, yz)

@@ -1,0 +1,171 @@
+"""Implicit (backward-Euler) wear jumps and their error (docs/model.md, "Long durations").
+
+On a Winkler foundation a vertex's pressure is linear in its elastic
+penetration ``p_i``, and Archard's and the energy laws make its wear rate
+linear in its pressure, so over a resolved cycle ``r_i = alpha_i pbar_i``
+(``pbar_i`` the cycle's mean penetration: its mean normal force over its
+stiffness). A jump of ``J`` cycles solves, backward Euler,
+
+    w_i = J alpha_i (p_i - beta_i z - w_i),     sum_i c_i beta_i (p_i - beta_i z - w_i)_+ = L,
+
+``p_i`` the penetration at the end of the cycle on the surface nearest the
+vertex, ``beta_i`` the free axis along its normal, ``z`` the move of a guided
+body along its axis, ``L`` its load: each vertex's penetration becomes
+``(p_i - beta_i z) / (1 + J alpha_i)`` and ``z`` is a 1-D monotone solve
+(:func:`balance`). A vertex touched during the cycle but not at its end (a
+gear flank) wears ``J alpha_i pbar_i / (1 + J alpha_i)``: bounded by its
+penetration, whatever ``J``. A vertex out of contact that the move brings in
+wears as the contact does on average per unit penetration.
+
+A jump is taken as two steps of ``J / 2`` (the second from the penetrations
+the first leaves); the same jump as one step of ``J`` differs from it by
+about its error (step doubling).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .kernels.contact import FACING
+from .motion import BalancedMotion, GuidedMotion
+from .surfaces import quaternion_matrix
+
+
+def contact_geometry(model, body, s):
+    """Per vertex of ``body`` (state ``s``), on the surface it is deepest in
+    or nearest to among those it faces: its penetration ``-Delta`` (m,
+    negative: a gap; ``-inf`` with no surface), that surface's normal (n, 3,
+    world) and the vertex's normal stiffness against it (N/m)."""
+    R = quaternion_matrix(s.pose[3:7])
+    x = s.pose[0:3] + s.vertices @ R.T
+    world = body.area_vectors[:, 0:3] @ R.T
+    n = len(x)
+    depth, normal, area = np.full(n, -np.inf), np.zeros((n, 3)), np.zeros(n)
+    rows = [np.broadcast_to(p[0:2], (n, 2, 3)) for p in model.planes]
+    rows += [vp[:, 0:2] for vp in s.vertex_planes]
+    for row in rows:
+        point, nrm = row[:, 0], row[:, 1]
+        projected = -np.einsum("ij,ij->i", world, nrm)
+        facing = projected > FACING * body.area_vectors[:, 3]
+        d = -np.einsum("ij,ij->i", x - point, nrm)
+        better = facing & (d > depth)
+        depth[better], normal[better], area[better] = d[better], nrm[better], projected[better]
+    return depth, normal, model.law[5] + model.law[6] * area
+
+
+def balance(depth, beta, stiffness, load):
+    """The move ``z`` (m) at which ``sum_j k_j beta_j (d_j - beta_j z)_+ = load``
+    (N): exact, on the piecewise-linear, non-increasing left side. 0 when no
+    pair can carry the load.
+
+    Parameters
+    ----------
+    depth, beta, stiffness : (m,) float
+        Penetration at ``z = 0`` (m), the axis along the normal, stiffness (N/m).
+    load : float
+    """
+    ok = (beta != 0.0) & (stiffness > 0.0) & np.isfinite(depth)
+    d, b, k = depth[ok], beta[ok], stiffness[ok]
+    if not len(d):
+        return 0.0
+    breaks = d / b
+    weight = k * b * b
+    up = b > 0.0                                   # pushes +axis while z < break
+    if (load >= 0.0 and not up.any()) or (load < 0.0 and up.all()):
+        return 0.0
+
+    points = np.unique(breaks)
+    # g at every breakpoint, by cumulative sums in sorted order
+    o_up, o_dn = np.argsort(breaks[up]), np.argsort(breaks[~up])
+    bu, wu = breaks[up][o_up], weight[up][o_up]
+    bd, wd = breaks[~up][o_dn], weight[~up][o_dn]
+    su0, su1 = np.concatenate([[0.0], np.cumsum(wu[::-1])])[::-1], \
+        np.concatenate([[0.0], np.cumsum((wu * bu)[::-1])])[::-1]
+    sd0, sd1 = np.concatenate([[0.0], np.cumsum(wd)]), np.concatenate([[0.0], np.cumsum(wd * bd)])
+    iu = np.searchsorted(bu, points, side="right")     # up pairs with break > point
+    idn = np.searchsorted(bd, points, side="left")     # down pairs with break < point
+    values = (su1[iu] - points * su0[iu]) - (points * sd0[idn] - sd1[idn])
+    if load >= values[0]:
+        slope = wu.sum()                          # left of every break: every up pair pushes
+        return float(points[0] - (load - values[0]) / slope) if slope > 0.0 else 0.0
+    if load <= values[-1]:
+        slope = wd.sum()
+        return float(points[-1] + (values[-1] - load) / slope) if slope > 0.0 else 0.0
+    j = int(np.searchsorted(-values, -load))     # values[j - 1] > load >= values[j]
+    z0, z1, g0, g1 = points[j - 1], points[j], values[j - 1], values[j]
+    return float(z0 + (g0 - load) / (g0 - g1) * (z1 - z0))
+
+
+@dataclass
+class BodyJump:
+    """What one body's jumps need from its last resolved cycle."""
+
+    alpha: np.ndarray        # (n,) wear per cycle per unit mean penetration (1 / cycle)
+    depth: np.ndarray        # (n,) penetration at the end of the cycle (m)
+    mean: np.ndarray         # (n,) mean penetration over the cycle (m)
+    normal: np.ndarray       # (n, 3) normal of the surface the depth is on (world)
+    stiffness: np.ndarray    # (n,) normal stiffness there (N/m)
+    member: np.ndarray       # (n,) bool: in the balance (touching at the end, or may)
+    touched: np.ndarray      # (n,) bool: touched during the cycle but not at its end
+    beta: np.ndarray         # (n,) free axis along the normal (0 without a free axis)
+    load: float              # load the contacts carry along the free axis (N)
+    guided: bool
+
+
+def measure(model, body, s, rate, steps):
+    """The :class:`BodyJump` of ``body`` after a resolved cycle of ``steps``
+    steps in which it wore ``rate`` (n,) (m per cycle)."""
+    depth, normal, stiffness = contact_geometry(model, body, s)
+    mean = np.where(stiffness > 0.0, s.load / steps / np.where(stiffness > 0.0, stiffness, 1.0),
+                    0.0)
+    wearing = (rate > 0.0) & (mean > 0.0)
+    alpha = np.zeros(len(rate))
+    alpha[wearing] = rate[wearing] / mean[wearing]
+    # untouched vertices the move may bring into contact: the contact's mean
+    # alpha per unit penetration (their own is unknown)
+    fresh = (mean <= 0.0) & np.isfinite(depth)
+    area = body.area_vectors[:, 3]
+    if wearing.any():
+        alpha[fresh] = (rate[wearing] @ area[wearing]) / (mean[wearing] @ area[wearing])
+    member = ((depth > 0.0) | fresh) & np.isfinite(depth) & (stiffness > 0.0)
+    touched = ~member & (mean > 0.0)
+    motion = body.motion
+    guided = isinstance(motion, (BalancedMotion, GuidedMotion)) and model.slots > 0
+    beta, load = np.zeros(len(rate)), 0.0
+    if guided:
+        beta = normal @ motion.axis
+        load = (motion.carried if isinstance(motion, BalancedMotion)
+                else -float(motion.params[19:22] @ motion.axis) / motion.params[0])
+    return BodyJump(alpha, np.where(np.isfinite(depth), depth, 0.0), mean, normal, stiffness,
+                    member, touched, beta, load, guided)
+
+
+def _step(m, jump, depth, mean):
+    """One backward-Euler step of ``jump`` cycles from penetrations ``depth``
+    (balance members) and ``mean`` (touched only): (n,) wear and the move z."""
+    relief = 1.0 / (1.0 + jump * m.alpha)
+    z = 0.0
+    if m.guided:
+        k = m.member
+        z = balance(depth[k], m.beta[k], m.stiffness[k] * relief[k], m.load)
+    wear = np.zeros(len(depth))
+    k = m.member
+    wear[k] = jump * m.alpha[k] * np.maximum(0.0, depth[k] - m.beta[k] * z) * relief[k]
+    t = m.touched
+    wear[t] = jump * m.alpha[t] * mean[t] * relief[t]
+    return wear, z
+
+
+def implicit(m, jump):
+    """Wear (n,), the body's move along its axis (m, from the balance without
+    a jump) and the error estimate (n,) of a jump of ``jump`` cycles, taken
+    as two backward-Euler steps of ``jump / 2``. The same jump as one step
+    differs from it by about its error (first order: the one step's error is
+    twice the two's), as in embedded Runge-Kutta pairs that advance with the
+    better of the two."""
+    z0 = _step(m, 0.0, m.depth, m.mean)[1]
+    whole, _ = _step(m, jump, m.depth, m.mean)
+    half, z1 = _step(m, 0.5 * jump, m.depth, m.mean)
+    rest, z2 = _step(m, 0.5 * jump, m.depth - m.beta * z1 - half, np.maximum(0.0, m.mean - half))
+    wear = half + rest
+    return wear, z1 + z2 - z0, np.abs(whole - wear)
