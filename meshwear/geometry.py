@@ -77,6 +77,16 @@ def load_mesh(path, units="m"):
     return clean(vertices * scale, faces, source=str(path))
 
 
+def load_part(config):
+    """The mesh of a body or mesh surface config: its ``mesh`` file (in its
+    ``units``) or its ``shape`` primitive; (vertices, faces)."""
+    if config.mesh is not None:
+        return load_mesh(config.mesh, config.units)
+    s = config.shape
+    return primitive(s.type, size=s.size, radius=s.radius, subdivisions=s.subdivisions,
+                     height=s.height, sections=s.sections)
+
+
 def _not_a_file(path):
     """Why ``path``, which is not a regular file, cannot be read."""
     if path.is_dir():

@@ -296,13 +296,7 @@ def _even_steps(n_steps, count):
 
 def _build_body(scene, index, body, surface_set):
     key = f"body[{index}]"
-    if body.mesh is not None:
-        vertices, faces = geometry.load_mesh(body.mesh, body.units)
-    else:
-        s = body.shape
-        vertices, faces = geometry.primitive(s.type, size=s.size, radius=s.radius,
-                                             subdivisions=s.subdivisions, height=s.height,
-                                             sections=s.sections)
+    vertices, faces = geometry.load_part(body)
     if body.resolution is not None:
         vertices, faces = geometry.refine(vertices, faces, body.resolution,
                                           face_mask=_faces_to_refine(scene, body, vertices, faces,

@@ -31,6 +31,7 @@ import numpy as np
 from numba import njit, prange
 
 from .contact import _named_copy, rotation_entries
+from .frames import offset, to_frame
 
 CYLINDER_RADIUS, CYLINDER_HALF_LENGTH, SIDE = 0, 1, 2
 SPHERE_RADIUS, SPHERE_SIDE = 0, 1
@@ -62,18 +63,13 @@ def _none(out, distance, i):
 
 
 def _cylinder_planes(body_vertices, pose, active, rotation, frame, geometry, out, distance):
-    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
+    pose_rotation = rotation_entries(pose[3:7])
     radius, half, sign = geometry[0], geometry[1], 1.0 - 2.0 * geometry[2]
     for k in prange(active.shape[0]):
         i = active[k]
-        bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
         # the vertex in the cylinder's frame: y = Rc^T (x - origin)
-        ex = pose[0] + r00 * bx + r01 * by + r02 * bz - frame[0, 0]
-        ey = pose[1] + r10 * bx + r11 * by + r12 * bz - frame[0, 1]
-        ez = pose[2] + r20 * bx + r21 * by + r22 * bz - frame[0, 2]
-        yx = rotation[0, 0] * ex + rotation[1, 0] * ey + rotation[2, 0] * ez
-        yy = rotation[0, 1] * ex + rotation[1, 1] * ey + rotation[2, 1] * ez
-        yz = rotation[0, 2] * ex + rotation[1, 2] * ey + rotation[2, 2] * ez
+        ex, ey, ez = offset(pose_rotation, pose, body_vertices, i, frame)
+        yx, yy, yz = to_frame(rotation, ex, ey, ez)
         r = np.sqrt(yx * yx + yy * yy)
         if abs(yz) > half or r == 0.0:
             _none(out, distance, i)
@@ -92,14 +88,12 @@ def _cylinder_planes(body_vertices, pose, active, rotation, frame, geometry, out
 
 
 def _sphere_planes(body_vertices, pose, active, rotation, frame, geometry, out, distance):
-    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
+    pose_rotation = rotation_entries(pose[3:7])
     radius, sign = geometry[0], 1.0 - 2.0 * geometry[1]
     for k in prange(active.shape[0]):
         i = active[k]
-        bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
-        ex = pose[0] + r00 * bx + r01 * by + r02 * bz - frame[0, 0]
-        ey = pose[1] + r10 * bx + r11 * by + r12 * bz - frame[0, 1]
-        ez = pose[2] + r20 * bx + r21 * by + r22 * bz - frame[0, 2]
+        # the vertex's offset from the centre (a sphere needs no frame axes)
+        ex, ey, ez = offset(pose_rotation, pose, body_vertices, i, frame)
         r = np.sqrt(ex * ex + ey * ey + ez * ez)
         if r == 0.0:
             _none(out, distance, i)

@@ -52,6 +52,25 @@ def _turn(axis0, axis1, axis2, angle):
             t * axis0 * axis2 - s * axis1, t * axis1 * axis2 + s * axis0, c + t * axis2 * axis2)
 
 
+@njit(cache=True, inline="always")
+def offset(r, pose, body_vertices, i, frame):
+    """World offset of vertex ``i`` of a body at ``pose`` (``r`` its rotation,
+    :func:`meshwear.kernels.contact.rotation_entries`) from the origin of a
+    surface's ``frame``."""
+    bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
+    return (pose[0] + r[0] * bx + r[1] * by + r[2] * bz - frame[0, 0],
+            pose[1] + r[3] * bx + r[4] * by + r[5] * bz - frame[0, 1],
+            pose[2] + r[6] * bx + r[7] * by + r[8] * bz - frame[0, 2])
+
+
+@njit(cache=True, inline="always")
+def to_frame(rotation, ex, ey, ez):
+    """A world offset in a surface's frame: ``rotation^T e``."""
+    return (rotation[0, 0] * ex + rotation[1, 0] * ey + rotation[2, 0] * ez,
+            rotation[0, 1] * ex + rotation[1, 1] * ey + rotation[2, 1] * ez,
+            rotation[0, 2] * ex + rotation[1, 2] * ey + rotation[2, 2] * ez)
+
+
 @njit(cache=True)
 def surface_frame(motion, terms, t, frozen, buffer, rotation, frame):
     """Fill ``rotation`` (3, 3) and ``frame`` (4, 3) with a surface's pose and

@@ -35,6 +35,7 @@ import numpy as np
 from numba import njit, prange
 
 from .contact import _named_copy, rotation_entries  # noqa: F401  (re-exported for twins)
+from .frames import offset, to_frame
 
 #: relative tolerance under which two faces count as equally near (a point
 #: beyond a shared edge or vertex); the one whose plane separates more wins
@@ -123,29 +124,22 @@ def _along(frames, f, row, x, y, z):
 
 def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
                     frames, corner_normals, grid, keys, starts, items, out, distance, hint):
-    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
+    r = rotation_entries(pose[3:7])
     smooth = corner_normals.shape[0] > 0
     reach2 = grid[7] * grid[7]
     over = OVER * grid[7]
     grow = 1.0 + 2.0 * TIE
     for k in prange(active.shape[0]):
         i = active[k]
-        bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
         # world position, then counter frame: y = Rc^T (x - origin)
-        ex = pose[0] + r00 * bx + r01 * by + r02 * bz - motion[0, 0]
-        ey = pose[1] + r10 * bx + r11 * by + r12 * bz - motion[0, 1]
-        ez = pose[2] + r20 * bx + r21 * by + r22 * bz - motion[0, 2]
-        yx = rotation[0, 0] * ex + rotation[1, 0] * ey + rotation[2, 0] * ez
-        yy = rotation[0, 1] * ex + rotation[1, 1] * ey + rotation[2, 1] * ez
-        yz = rotation[0, 2] * ex + rotation[1, 2] * ey + rotation[2, 2] * ez
+        ex, ey, ez = offset(r, pose, body_vertices, i, motion)
+        yx, yy, yz = to_frame(rotation, ex, ey, ez)
         # the normal it was given last step (world), zero if none: a vertex
         # keeps to the faces it came from (TRACKING)
         ox, oy, oz = out[i, 1, 0], out[i, 1, 1], out[i, 1, 2]
         tracked = ox != 0.0 or oy != 0.0 or oz != 0.0
         # the previous normal in the counter frame
-        tx = rotation[0, 0] * ox + rotation[1, 0] * oy + rotation[2, 0] * oz
-        ty = rotation[0, 1] * ox + rotation[1, 1] * oy + rotation[2, 1] * oz
-        tz = rotation[0, 2] * ox + rotation[1, 2] * oy + rotation[2, 2] * oz
+        tx, ty, tz = to_frame(rotation, ox, oy, oz)
         # the nearest face, and the nearest of the faces the vertex can stay
         # on (within TRACKING of its last normal, and with the vertex over
         # it, not beyond its edges: past a convex edge the vertex lets go)

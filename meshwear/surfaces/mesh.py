@@ -70,13 +70,7 @@ class MeshSurface(CounterSurface):
         geometry.MeshError
             For a mesh the engine cannot use; the caller adds the key.
         """
-        if config.mesh is not None:
-            vertices, faces = geometry.load_mesh(config.mesh, config.units)
-        else:
-            s = config.shape
-            vertices, faces = geometry.primitive(s.type, size=s.size, radius=s.radius,
-                                                 subdivisions=s.subdivisions, height=s.height,
-                                                 sections=s.sections)
+        vertices, faces = geometry.load_part(config)
         if config.resolution is not None:
             vertices, faces = geometry.refine(vertices, faces, config.resolution)
         return cls(config.name, vertices, faces, config.position, config.orientation,
