@@ -26,27 +26,30 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .kernels.balance import solve
 from .kernels.contact import FACING
 from .motion import BalancedMotion, GuidedMotion
 from .surfaces import quaternion_matrix
 
 
-def contact_geometry(model, body, s):
-    """Per vertex of ``body`` (state ``s``), on the surface it is deepest in
-    or nearest to among those it faces: its penetration ``-Delta`` (m,
-    negative: a gap; ``-inf`` with no surface), that surface's normal (n, 3,
-    world) and the vertex's normal stiffness against it (N/m)."""
+def contact_geometry(model, body, s, index):
+    """For the vertices ``index`` (k,) of ``body`` (state ``s``), on the
+    surface each is deepest in or nearest to among those it faces: its
+    penetration ``-Delta`` (m, negative: a gap; ``-inf`` with no surface),
+    that surface's normal (k, 3, world) and the vertex's normal stiffness
+    against it (N/m)."""
     R = quaternion_matrix(s.pose[3:7])
-    x = s.pose[0:3] + s.vertices @ R.T
-    world = body.area_vectors[:, 0:3] @ R.T
+    x = s.pose[0:3] + s.vertices[index] @ R.T
+    world = body.area_vectors[index, 0:3] @ R.T
+    length = body.area_vectors[index, 3]
     n = len(x)
     depth, normal, area = np.full(n, -np.inf), np.zeros((n, 3)), np.zeros(n)
     rows = [np.broadcast_to(p[0:2], (n, 2, 3)) for p in model.planes]
-    rows += [vp[:, 0:2] for vp in s.vertex_planes]
+    rows += [vp[index, 0:2] for vp in s.vertex_planes]
     for row in rows:
         point, nrm = row[:, 0], row[:, 1]
         projected = -np.einsum("ij,ij->i", world, nrm)
-        facing = projected > FACING * body.area_vectors[:, 3]
+        facing = projected > FACING * length
         d = -np.einsum("ij,ij->i", x - point, nrm)
         better = facing & (d > depth)
         depth[better], normal[better], area[better] = d[better], nrm[better], projected[better]
@@ -55,8 +58,8 @@ def contact_geometry(model, body, s):
 
 def balance(depth, beta, stiffness, load):
     """The move ``z`` (m) at which ``sum_j k_j beta_j (d_j - beta_j z)_+ = load``
-    (N): exact, on the piecewise-linear, non-increasing left side. 0 when no
-    pair can carry the load.
+    (N): the quasi-static balance's solve (:func:`meshwear.kernels.balance.solve`)
+    on these pairs. 0 when no pair can carry the load.
 
     Parameters
     ----------
@@ -65,79 +68,62 @@ def balance(depth, beta, stiffness, load):
     load : float
     """
     ok = (beta != 0.0) & (stiffness > 0.0) & np.isfinite(depth)
-    d, b, k = depth[ok], beta[ok], stiffness[ok]
-    if not len(d):
-        return 0.0
-    breaks = d / b
-    weight = k * b * b
-    up = b > 0.0                                   # pushes +axis while z < break
-    if (load >= 0.0 and not up.any()) or (load < 0.0 and up.all()):
-        return 0.0
-
-    points = np.unique(breaks)
-    # g at every breakpoint, by cumulative sums in sorted order
-    o_up, o_dn = np.argsort(breaks[up]), np.argsort(breaks[~up])
-    bu, wu = breaks[up][o_up], weight[up][o_up]
-    bd, wd = breaks[~up][o_dn], weight[~up][o_dn]
-    su0, su1 = np.concatenate([[0.0], np.cumsum(wu[::-1])])[::-1], \
-        np.concatenate([[0.0], np.cumsum((wu * bu)[::-1])])[::-1]
-    sd0, sd1 = np.concatenate([[0.0], np.cumsum(wd)]), np.concatenate([[0.0], np.cumsum(wd * bd)])
-    iu = np.searchsorted(bu, points, side="right")     # up pairs with break > point
-    idn = np.searchsorted(bd, points, side="left")     # down pairs with break < point
-    values = (su1[iu] - points * su0[iu]) - (points * sd0[idn] - sd1[idn])
-    if load >= values[0]:
-        slope = wu.sum()                          # left of every break: every up pair pushes
-        return float(points[0] - (load - values[0]) / slope) if slope > 0.0 else 0.0
-    if load <= values[-1]:
-        slope = wd.sum()
-        return float(points[-1] + (values[-1] - load) / slope) if slope > 0.0 else 0.0
-    j = int(np.searchsorted(-values, -load))     # values[j - 1] > load >= values[j]
-    z0, z1, g0, g1 = points[j - 1], points[j], values[j - 1], values[j]
-    return float(z0 + (g0 - load) / (g0 - g1) * (z1 - z0))
+    b = beta[ok]
+    breaks = np.ascontiguousarray(depth[ok] / b)
+    weights = np.ascontiguousarray(stiffness[ok] * b * np.abs(b))
+    z = solve(breaks, weights, len(breaks), float(load), 0.0) if len(breaks) else np.nan
+    return float(z) if np.isfinite(z) else 0.0
 
 
 @dataclass
 class BodyJump:
-    """What one body's jumps need from its last resolved cycle."""
+    """What one body's jumps need from its last resolved cycle, for the
+    vertices ``index`` that touched or can touch (the others do not wear)."""
 
-    alpha: np.ndarray        # (n,) wear per cycle per unit mean penetration (1 / cycle)
-    depth: np.ndarray        # (n,) penetration at the end of the cycle (m)
-    mean: np.ndarray         # (n,) mean penetration over the cycle (m)
-    normal: np.ndarray       # (n, 3) normal of the surface the depth is on (world)
-    stiffness: np.ndarray    # (n,) normal stiffness there (N/m)
-    member: np.ndarray       # (n,) bool: in the balance (touching at the end, or may)
-    touched: np.ndarray      # (n,) bool: touched during the cycle but not at its end
-    beta: np.ndarray         # (n,) free axis along the normal (0 without a free axis)
+    index: np.ndarray        # (k,) int64 the vertices (active, or worn in the cycle)
+    alpha: np.ndarray        # (k,) wear per cycle per unit mean penetration (1 / cycle)
+    depth: np.ndarray        # (k,) penetration at the end of the cycle (m)
+    mean: np.ndarray         # (k,) mean penetration over the cycle (m)
+    normal: np.ndarray       # (k, 3) normal of the surface the depth is on (world)
+    stiffness: np.ndarray    # (k,) normal stiffness there (N/m)
+    member: np.ndarray       # (k,) bool: in the balance (touching at the end, or may)
+    touched: np.ndarray      # (k,) bool: touched during the cycle but not at its end
+    beta: np.ndarray         # (k,) free axis along the normal (0 without a free axis)
     load: float              # load the contacts carry along the free axis (N)
     guided: bool
+    rest: float = 0.0        # the balance without a jump (m): moves are from it
 
 
 def measure(model, body, s, rate, steps):
     """The :class:`BodyJump` of ``body`` after a resolved cycle of ``steps``
     steps in which it wore ``rate`` (n,) (m per cycle)."""
-    depth, normal, stiffness = contact_geometry(model, body, s)
-    mean = np.where(stiffness > 0.0, s.load / steps / np.where(stiffness > 0.0, stiffness, 1.0),
-                    0.0)
+    index = np.union1d(s.active, np.flatnonzero(rate > 0.0)).astype(np.int64)
+    rate = rate[index]
+    depth, normal, stiffness = contact_geometry(model, body, s, index)
+    load = s.load[index]
+    mean = np.where(stiffness > 0.0, load / steps / np.where(stiffness > 0.0, stiffness, 1.0), 0.0)
     wearing = (rate > 0.0) & (mean > 0.0)
     alpha = np.zeros(len(rate))
     alpha[wearing] = rate[wearing] / mean[wearing]
     # untouched vertices the move may bring into contact: the contact's mean
     # alpha per unit penetration (their own is unknown)
     fresh = (mean <= 0.0) & np.isfinite(depth)
-    area = body.area_vectors[:, 3]
+    area = body.area_vectors[index, 3]
     if wearing.any():
         alpha[fresh] = (rate[wearing] @ area[wearing]) / (mean[wearing] @ area[wearing])
     member = ((depth > 0.0) | fresh) & np.isfinite(depth) & (stiffness > 0.0)
     touched = ~member & (mean > 0.0)
     motion = body.motion
     guided = isinstance(motion, (BalancedMotion, GuidedMotion)) and model.slots > 0
-    beta, load = np.zeros(len(rate)), 0.0
+    beta, carried = np.zeros(len(rate)), 0.0
     if guided:
         beta = normal @ motion.axis
-        load = (motion.carried if isinstance(motion, BalancedMotion)
+        carried = (motion.carried if isinstance(motion, BalancedMotion)
                 else -float(motion.params[19:22] @ motion.axis) / motion.params[0])
-    return BodyJump(alpha, np.where(np.isfinite(depth), depth, 0.0), mean, normal, stiffness,
-                    member, touched, beta, load, guided)
+    m = BodyJump(index, alpha, np.where(np.isfinite(depth), depth, 0.0), mean, normal,
+                 stiffness, member, touched, beta, carried, guided)
+    m.rest = _step(m, 0.0, m.depth, m.mean)[1]
+    return m
 
 
 def _step(m, jump, depth, mean):
@@ -157,15 +143,15 @@ def _step(m, jump, depth, mean):
 
 
 def implicit(m, jump):
-    """Wear (n,), the body's move along its axis (m, from the balance without
-    a jump) and the error estimate (n,) of a jump of ``jump`` cycles, taken
+    """Wear (k,) of the vertices ``m.index``, the body's move along its axis
+    (m, from the balance without a jump) and the error estimate (k,) of a
+    jump of ``jump`` cycles, taken
     as two backward-Euler steps of ``jump / 2``. The same jump as one step
     differs from it by about its error (first order: the one step's error is
     twice the two's), as in embedded Runge-Kutta pairs that advance with the
     better of the two."""
-    z0 = _step(m, 0.0, m.depth, m.mean)[1]
     whole, _ = _step(m, jump, m.depth, m.mean)
     half, z1 = _step(m, 0.5 * jump, m.depth, m.mean)
     rest, z2 = _step(m, 0.5 * jump, m.depth - m.beta * z1 - half, np.maximum(0.0, m.mean - half))
     wear = half + rest
-    return wear, z1 + z2 - z0, np.abs(whole - wear)
+    return wear, z1 + z2 - m.rest, np.abs(whole - wear)

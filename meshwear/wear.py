@@ -187,7 +187,11 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
         js.last_jump = jump
         js.rate = rates
         if implicit:
-            js.alpha = [np.where(m.mean > 0.0, m.alpha, 0.0) for m in measures]
+            js.alpha = []
+            for m, rate in zip(measures, rates):
+                alpha = np.zeros(len(rate))
+                alpha[m.index] = np.where(m.mean > 0.0, m.alpha, 0.0)
+                js.alpha.append(alpha)
         js.gap = jump + 1.0 + (1.0 if js.settling else 0.0)
         if checkpoint is not None:
             checkpoint(model, state)
@@ -213,12 +217,13 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None):
     fastest = max(float(r.max()) if len(r) else 0.0 for r in rates)
     if forced is not None:
         jump = min(end, could)
-        return jump, "forced", [jumps.implicit(m, jump) for m in measures]
+        return jump, "forced", _spread(measures, rates, jump)
     if fastest <= 0.0 or any(a is None for a in js.alpha):
         return 0, "accuracy", None
     bounds = {"end": float(end), "growth": float(could)}
     drift = 0.0
     for m, previous in zip(measures, js.alpha):
+        previous = previous[m.index]
         both = (m.mean > 0.0) & (previous > 0.0) & (m.alpha > 0.0)
         if both.any():
             rho = np.abs(m.alpha[both] - previous[both]) / max(js.gap, 1.0)
@@ -231,12 +236,25 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None):
         if jump < 1:
             return 0, "accuracy", None
         results = [jumps.implicit(m, jump) for m in measures]
-        worst = max(float(e.max()) for _, _, e in results) / (tolerance * jump * fastest)
+        worst = max(float(e.max(initial=0.0)) for _, _, e in results) / (tolerance * jump
+                                                                          * fastest)
         if worst <= 1.0:
-            return jump, which, results
+            return jump, which, _spread(measures, rates, jump, results)
         # the error grows like J^2, its allowance like J
         jump, which = int(jump * min(0.9 / worst, 0.5 if worst > 2.0 else 0.9)), "accuracy"
     return 0, "accuracy", None
+
+
+def _spread(measures, rates, jump, results=None):
+    """Per body ``(wear, move, error)`` of an implicit jump over every vertex
+    (the jump measures the vertices that touch or can touch only)."""
+    out = []
+    for k, (m, rate) in enumerate(zip(measures, rates)):
+        wear, move, error = results[k] if results is not None else jumps.implicit(m, jump)
+        full, estimate = np.zeros(len(rate)), np.zeros(len(rate))
+        full[m.index], estimate[m.index] = wear, error
+        out.append((full, move, estimate))
+    return out
 
 
 #: the per-vertex arrays a jump extrapolates
@@ -253,7 +271,10 @@ def _jump(model, state, before, rates, jump, results, measures=None):
         _, vertices0, volume0, work0 = b
         span = {name: getattr(s, name).copy() for name in JUMPED}
         wear, z, _ = results[k]
-        normal = measures[k].normal if measures is not None else None
+        normal = None
+        if measures is not None:
+            normal = np.zeros((len(rate), 3))
+            normal[measures[k].index] = measures[k].normal
         # every increment of the cycle scaled like the vertex's wear: a
         # vertex relieved by the jump wears, and dissipates, less
         factor = np.full(len(rate), float(jump))
@@ -287,9 +308,10 @@ def _jump(model, state, before, rates, jump, results, measures=None):
         s.pose[0:3] += span["shift"]
         body.motion.place(s.pose, state.time)
         moved = s.pose[0:3] - start
+        a = s.active                      # the others are in no contact
         for j, n in enumerate(slot_normals(model, s)):
-            n = np.broadcast_to(n, s.tangential[j, :, ANCHOR].shape)
-            s.tangential[j, :, ANCHOR] += moved - np.einsum("ij,j->i", n, moved)[:, None] * n
+            n = np.broadcast_to(n, s.tangential[j, :, ANCHOR].shape)[a]
+            s.tangential[j, a, ANCHOR] += moved - np.einsum("ij,j->i", n, moved)[:, None] * n
     return spans
 
 

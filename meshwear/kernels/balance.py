@@ -101,6 +101,15 @@ def balance_offset(body_vertices, pose, axis, planes, vertex_planes, active, are
     breakpoint, weight = scratch[0], scratch[1]
     count = _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law, scale,
                    breakpoint, weight)
+    return solve(breakpoint, weight, count, load, guess)
+
+
+@njit(cache=True)
+def solve(breakpoint, weight, count, load, guess):
+    """The ``z`` at which ``g(z) = load`` for the first ``count`` pairs of
+    ``breakpoint`` (z_j, m) and ``weight`` (w_j, N/m, signed as beta): the
+    bracketed Newton iteration of :func:`balance_offset`; NaN when no pair
+    pushes the way the load needs."""
     # the side that must carry the load: pairs pushing along +axis for a
     # positive load (beta > 0), along -axis for a negative one
     edge = np.nan

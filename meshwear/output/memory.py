@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from .fields import body_quantities
+from .fields import body_totals
 
 
 class MemoryHistory:
@@ -19,7 +19,7 @@ class MemoryHistory:
 
     def on_sample(self, model, state):
         for body, s in zip(model.bodies, state.bodies):
-            q = body_quantities(body, s, model)
+            q = body_totals(body, s)
             r = self._rows.setdefault(body.name, {k: [] for k in (
                 "time", "pose", "origin", "wrench", "friction_work", "wear_volume",
                 "max_wear_depth", "wear_depth", "contact_points", "active", "resolved")})
@@ -31,7 +31,7 @@ class MemoryHistory:
             r["wear_volume"].append(q["wear_volume"])
             r["max_wear_depth"].append(q["max_wear_depth"])
             r["wear_depth"].append(s.wear_depth.copy())
-            r["contact_points"].append(int((q["contact_state"] > 0).sum()))
+            r["contact_points"].append(q["contact_points"])
             r["active"].append(len(s.active))
             r["resolved"].append(bool(state.resolved))
 

@@ -7,7 +7,7 @@ Physics never writes files; :func:`meshwear.simulate.run` calls
 from pathlib import Path
 
 from ..wear import error_estimate
-from .fields import body_quantities
+from .fields import body_quantities, body_totals
 from .tables import HISTORY_COLUMNS, HistoryWriter, write_json_atomic
 from .vtk import PVDSeries
 
@@ -50,8 +50,7 @@ class RunRecorder:
 
     def on_sample(self, model, state):
         for body, s in zip(model.bodies, state.bodies):
-            q = body_quantities(body, s, model)
-            states = q["contact_state"]
+            q = body_totals(body, s)
             row = dict(zip(("x", "y", "z"), q["origin"]))
             row.update(zip(("qw", "qx", "qy", "qz"), s.pose[3:7]))
             row.update(zip(("vx", "vy", "vz"), s.pose[7:10]))
@@ -59,8 +58,8 @@ class RunRecorder:
             row.update(zip(("fx", "fy", "fz", "tx", "ty", "tz"), s.wrench))
             row.update(time=state.time, body=body.name, friction_work=q["total_friction_work"],
                        wear_volume=q["wear_volume"], max_wear_depth=q["max_wear_depth"],
-                       contact_points=int((states > 0).sum()), stick_points=int((states == 1).sum()),
-                       slip_points=int((states == 2).sum()), resolved=int(state.resolved))
+                       contact_points=q["contact_points"], stick_points=q["stick_points"],
+                       slip_points=q["slip_points"], resolved=int(state.resolved))
             self.history.write(row)
 
     def on_frame(self, model, state):
@@ -104,7 +103,7 @@ def summary(model, state, wall_time, status="ok", message=None):
     if message:
         out["message"] = message
     for body, s in zip(model.bodies, state.bodies):
-        q = body_quantities(body, s, model)
+        q = body_totals(body, s)
         out["bodies"][body.name] = {
             "wear_volume": q["wear_volume"],
             "max_wear_depth": q["max_wear_depth"],
@@ -114,7 +113,7 @@ def summary(model, state, wall_time, status="ok", message=None):
             "velocity": s.pose[7:10].tolist(),
             "angular_velocity": s.pose[10:13].tolist(),
             "contact_force": s.wrench[0:3].tolist(),
-            "contact_points": int((q["contact_state"] > 0).sum()),
+            "contact_points": q["contact_points"],
             "vertices": int(len(s.wear_depth)),
             "active_vertices": int(len(s.active)),
         }
