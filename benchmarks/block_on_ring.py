@@ -144,7 +144,7 @@ def write_page(rows):
             f"{r['resolved']:.0f} of {r['cycles']:.0f} | {1e6 * r['depth']:.3f} µm | "
             f"{1e6 * r['depth_closed']:.3f} µm | {r['volume_error']:+.1e} | "
             f"{r['arc_error']:.1e} | {conv} |")
-    a, m = rows[0], rows[1]
+    m = rows[1]
     lines += ["", f"Mesh ring against analytic ring: the scars differ by at most "
               f"{m['mesh_vs_analytic']:.1e} of the depth.", "",
               "![the scar on the block](../img/block_on_ring_profile.png)", "", MARK_END]

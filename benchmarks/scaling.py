@@ -291,7 +291,7 @@ def write_docs(rows, ref, size_ratio, top, box, fine, sliding, turning):
               f"- A mesh counter-surface costs {box:.2f}× the plane (a 12-face box) and",
               f"  {fine:.2f}× (a 2·10⁴-face sheet) at the same 10⁴ active vertices (target ≤ 5×):",
               "  the face lookup is the extra.",
-              f"- Sliding at 0.1 m/s over the sheet (the active set refreshed every ~10 steps)",
+              "- Sliding at 0.1 m/s over the sheet (the active set refreshed every ~10 steps)",
               f"  costs {sliding:.2f}× sliding on the plane, which never refreshes (only motion",
               "  along a plane's normal counts).",
               f"- The pin on a turning disc costs {turning['analytic disc']:.2f}× (an analytic",

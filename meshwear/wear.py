@@ -123,8 +123,6 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
     at the end): the fixed-factor scheme of finite-element wear codes, for
     comparisons and tests.
     """
-    from .simulate import advance
-
     n_c = model.cycle_steps
     tolerance = model.scene.wear.tolerance
     implicit = model.scene.wear.jump == "implicit"

@@ -128,7 +128,7 @@ def test_forced_implicit_jumps_ten_times_longer_stay_within_the_tolerance(punch,
     of J k K s = 25 relax each vertex's pressure by 1 / (1 + J k K s) instead
     of overshooting it, so the tilt decays, the profile stays within the
     tolerance of the resolved one and the volume is k P s."""
-    (ref_model, ref), (model, state) = punch["ref 10"], punch["implicit 10"]
+    (_, ref), (model, state) = punch["ref 10"], punch["implicit 10"]
     k, load = model.scene.wear.coefficient, 10.0
     assert 500 * k * 1e13 * 0.0005 == pytest.approx(25.0)
     assert state.jump.jumps == 2 and state.jump.last_jump >= 400

@@ -74,10 +74,13 @@ def _close(a, b):
 @pytest.mark.parametrize("kernel", [contact.contact_serial, contact.contact_parallel])
 @pytest.mark.parametrize("wear_law", [contact.ENERGY, contact.ENERGY_DENSITY, contact.ARCHARD])
 @pytest.mark.parametrize("along_vertex_normal", [False, True])
-def test_contact_matches_numpy_twin(kernel, wear_law, along_vertex_normal):
+@pytest.mark.parametrize("n_planes", [1, 2])
+def test_contact_matches_numpy_twin(kernel, wear_law, along_vertex_normal, n_planes):
+    """Two planes run the general build; one plane and no mesh surface the
+    build compiled for that case (the same computation)."""
     rng = np.random.default_rng(7 + wear_law)
     vertices, pose, planes, params, law, direction, arrays = _random_case(
-        rng, 400, 2, wear_law, along_vertex_normal)
+        rng, 400, n_planes, wear_law, along_vertex_normal)
     twin_vertices = vertices.copy()
     twin_arrays = {k: v.copy() for k, v in arrays.items()}
     seen_states = set()

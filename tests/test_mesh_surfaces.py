@@ -11,7 +11,6 @@ import trimesh
 
 import reference
 from meshwear.kernels import nearest
-from meshwear.kernels.contact import all_vertices
 from meshwear.scene import load_scene
 from meshwear.simulate import run_scene
 

@@ -2,10 +2,13 @@
 
 One fused kernel does, for every active vertex ``i`` of a worn body and every
 counter-surface ``s`` (the analytic planes first, then the mesh surfaces), the
-phases of DESIGN.md §1 in order: penetration, normal force (eq. 1), the
+phases of docs/model.md in order: penetration, normal force (eq. 1), the
 stick/slip state machine (eq. 2-4), dissipated energy, wear (eq. 5 and its
 variants) and the geometry update. Fusing keeps each vertex's data in registers
-for one pass; the phases stay readable as the small inline functions below.
+for one pass. The kernel is compiled four times from the one definition
+:func:`_contact`: serial and threaded, each in general and for the common case
+of one analytic plane and no mesh surface (see :func:`_build`); what made it
+fast is in docs/performance.md.
 
 Array conventions (all C-contiguous float64 unless said otherwise):
 
@@ -24,7 +27,8 @@ vertex_planes : (M, n, 3, 3)
     that point (:mod:`meshwear.kernels.nearest` fills it); a zero normal means
     no face within reach. Pair slot ``P + m``.
 active : (k,) int64
-    Indices of the vertices to process (the active set); the others are out of
+    Indices of the vertices to process (the active set), each in
+    ``0 .. n - 1`` (no negative, numpy-style index); the others are out of
     reach of every surface and keep no contact.
 area : (n, 4)
     Area vector of each vertex in the body frame (m², the third of each
@@ -38,7 +42,7 @@ law : (13,)
     contact coefficients as (per point, per area) pairs: normal stiffness,
     normal damping, tangential stiffness, tangential damping. Point ``i`` gets
     ``c_i = c_point + c_area A_i`` (N/m), ``A_i`` the contact area, and likewise ``d_i``, ``c_t,i``,
-    ``d_t,i``: one of each pair is zero (DESIGN.md §1, per point or Winkler).
+    ``d_t,i``: one of each pair is zero (docs/model.md, per point or Winkler).
 body_vertices : (n, 3)
     Worn vertex positions in the body frame (m, relative to the centre of
     mass); wear moves them in place.
@@ -113,12 +117,20 @@ def rotation_entries(q):
             2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y))
 
 
+#: set in the build for one analytic plane and no mesh surface (see _build)
+ONE_PLANE = False
+
+
 def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear_direction,
              contact_state, tangential, normal_force,
              friction_work, wear_depth, wear_volume, wrench):
     n_points = body_vertices.shape[0]
-    n_planes = planes.shape[0]
-    n_slots = n_planes + vertex_planes.shape[0]
+    if ONE_PLANE:
+        # constant counts: LLVM drops the slot loop and the mesh branches
+        n_planes = n_slots = 1
+    else:
+        n_planes = planes.shape[0]
+        n_slots = n_planes + vertex_planes.shape[0]
     f, f0, wear_law, k, dt = law[0], law[1], int(law[2]), law[3], law[4]
     c0, c1, d0, d1 = law[5], law[6], law[7], law[8]
     ct0, ct1, dt0, dt1 = law[9], law[10], law[11], law[12]
@@ -128,15 +140,18 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
     vx, vy, vz = pose[7], pose[8], pose[9]
     wx, wy, wz = pose[10], pose[11], pose[12]
     fx = fy = fz = tx = ty = tz = 0.0
-    # plane normals in the body frame, R^T n
-    local = np.empty((n_planes, 3))
+    # per plane: its normal in the body frame, R^T n, and whether it turns
+    local = np.empty((n_planes, 4))
     for s in range(n_planes):
         nx, ny, nz = planes[s, 1, 0], planes[s, 1, 1], planes[s, 1, 2]
         local[s, 0] = r00 * nx + r10 * ny + r20 * nz
         local[s, 1] = r01 * nx + r11 * ny + r21 * nz
         local[s, 2] = r02 * nx + r12 * ny + r22 * nz
+        turns = planes[s, 3, 0] != 0.0 or planes[s, 3, 1] != 0.0 or planes[s, 3, 2] != 0.0
+        local[s, 3] = 1.0 if turns else 0.0
     for slot in prange(active.shape[0]):
-        i = active[slot]
+        # unsigned, so that indexing skips numpy's negative-index wrap-around
+        i = np.uint64(active[slot])
         bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
         # world offset from the centre of mass, position and velocity of point A
         rx = r00 * bx + r01 * by + r02 * bz
@@ -147,20 +162,29 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
         uy = vy + wz * rx - wx * rz
         uz = vz + wx * ry - wy * rx
         for s in range(n_slots):
+            # the counter-surface's plane under A, read as scalars (an array
+            # view here would cost a reference count per pair): point o,
+            # normal n, velocity, and n in the body frame (mx, my, mz)
             if s < n_planes:
-                plane = planes[s]
+                ox, oy, oz = planes[s, 0, 0], planes[s, 0, 1], planes[s, 0, 2]
+                nx, ny, nz = planes[s, 1, 0], planes[s, 1, 1], planes[s, 1, 2]
+                svx, svy, svz = planes[s, 2, 0], planes[s, 2, 1], planes[s, 2, 2]
                 mx, my, mz = local[s, 0], local[s, 1], local[s, 2]
             else:
                 # a mesh counter-surface: the plane of its face under this
                 # vertex (a zero normal: no face within reach)
-                plane = vertex_planes[s - n_planes, i]
-                hx, hy, hz = plane[1, 0], plane[1, 1], plane[1, 2]
-                mx = r00 * hx + r10 * hy + r20 * hz
-                my = r01 * hx + r11 * hy + r21 * hz
-                mz = r02 * hx + r12 * hy + r22 * hz
-            nx, ny, nz = plane[1, 0], plane[1, 1], plane[1, 2]
-            # Delta = (x - p) . n, negative in penetration
-            delta = (px - plane[0, 0]) * nx + (py - plane[0, 1]) * ny + (pz - plane[0, 2]) * nz
+                m = s - n_planes
+                ox, oy = vertex_planes[m, i, 0, 0], vertex_planes[m, i, 0, 1]
+                oz = vertex_planes[m, i, 0, 2]
+                nx, ny = vertex_planes[m, i, 1, 0], vertex_planes[m, i, 1, 1]
+                nz = vertex_planes[m, i, 1, 2]
+                svx, svy = vertex_planes[m, i, 2, 0], vertex_planes[m, i, 2, 1]
+                svz = vertex_planes[m, i, 2, 2]
+                mx = r00 * nx + r10 * ny + r20 * nz
+                my = r01 * nx + r11 * ny + r21 * nz
+                mz = r02 * nx + r12 * ny + r22 * nz
+            # penetration (docs/model.md): Delta = (x - o) . n, negative inside
+            delta = (px - ox) * nx + (py - oy) * ny + (pz - oz) * nz
             # contact area: the vertex's area vector projected on the plane,
             # -(R a) . n; a vertex whose surface does not face the plane
             # (a side face standing on it) carries nothing
@@ -174,18 +198,19 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
             # point of the plane under A
             ax, ay, az = px - delta * nx, py - delta * ny, pz - delta * nz
             # the counter-surface's velocity there: a plane's translation plus
-            # its turn about its point; a mesh or analytic surface's, as given
-            svx, svy, svz = plane[2, 0], plane[2, 1], plane[2, 2]
-            if s < n_planes:
-                ox, oy, oz = plane[3, 0], plane[3, 1], plane[3, 2]
-                kx, ky, kz = ax - plane[0, 0], ay - plane[0, 1], az - plane[0, 2]
-                svx += oy * kz - oz * ky
-                svy += oz * kx - ox * kz
-                svz += ox * ky - oy * kx
+            # its turn about its point (skipped for a plane that does not
+            # turn: it adds zero); a mesh surface's, as given
+            if s < n_planes and local[s, 3] != 0.0:
+                wpx, wpy, wpz = planes[s, 3, 0], planes[s, 3, 1], planes[s, 3, 2]
+                kx, ky, kz = ax - ox, ay - oy, az - oz
+                svx += wpy * kz - wpz * ky
+                svy += wpz * kx - wpx * kz
+                svz += wpx * ky - wpy * kx
             # velocity of A relative to the surface: normal rate and slip velocity
             gx, gy, gz = ux - svx, uy - svy, uz - svz
             rate = gx * nx + gy * ny + gz * nz
             sx, sy, sz = gx - rate * nx, gy - rate * ny, gz - rate * nz
+            # coefficients of the point (docs/model.md, per point or per area)
             c, d, ct, dtan = c0 + c1 * a, d0 + d1 * a, ct0 + ct1 * a, dt0 + dt1 * a
             # eq. 1: spring-damper normal force, no adhesion
             load = -(c * delta + d * rate)
@@ -194,9 +219,9 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
             normal_force[s, i] = load
             state = contact_state[s, i]
             reversed_now = False
-            # friction state of the pair (tangential[s, i]): stick anchor o,
-            # force when stick began h, friction force F, last slip velocity l;
-            # read and written only where the state machine needs them
+            # eq. 2-4, the friction state of the pair (tangential[s, i]): stick
+            # anchor o, force when stick began h, friction force F, last slip
+            # velocity l; read and written only where the state machine needs them
             if state == STICK:
                 # the anchor is a point of the counter-surface: it moves with it
                 tangential[s, i, ANCHOR, 0] += svx * dt
@@ -261,6 +286,7 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
                         tangential[s, i, SLIP_VELOCITY, 1] = -Fy
                         tangential[s, i, SLIP_VELOCITY, 2] = -Fz
                 else:
+                    # dissipated energy (docs/model.md): the dashpot's
                     energy = dtan * speed2 * dt
             if speed2 > 0.0:
                 tangential[s, i, SLIP_VELOCITY, 0] = sx
@@ -280,9 +306,12 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
                 if ll > 0.0:
                     scale = -f * load / ll
                     Fx, Fy, Fz = scale * lx, scale * ly, scale * lz
+                # dissipated energy (docs/model.md): f N |v| dt
                 energy = f * load * speed * dt
             contact_state[s, i] = state
-            tangential[s, i, FORCE, 0], tangential[s, i, FORCE, 1], tangential[s, i, FORCE, 2] = Fx, Fy, Fz
+            tangential[s, i, FORCE, 0] = Fx
+            tangential[s, i, FORCE, 1] = Fy
+            tangential[s, i, FORCE, 2] = Fz
             # eq. 5 and variants: wear depth and volume increments
             if wear_law == ENERGY:
                 dw = k * energy
@@ -299,8 +328,8 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
             if dw > 0.0:
                 wear_depth[i] += dw
                 wear_volume[i] += dv
-                # geometry update: into the body along +n, in the body frame
-                # (mx, my, mz) is the contact normal in the body frame
+                # geometry update (docs/model.md): into the body along +n, in
+                # the body frame; (mx, my, mz) is the contact normal there
                 if along_vertex_normal:
                     mx, my, mz = wear_direction[i, 0], wear_direction[i, 1], wear_direction[i, 2]
                     if state == STICK:
@@ -329,10 +358,32 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
     wrench[3], wrench[4], wrench[5] = tx, ty, tz
 
 
-def _named_copy(fn, name):
-    """The same function under another name: numba's on-disk cache is keyed by
-    the qualified name, so the serial and threaded builds need distinct ones."""
-    copy = types.FunctionType(fn.__code__, fn.__globals__, name, fn.__defaults__, fn.__closure__)
+#: the builds a copy of _dispatch calls, set per copy by _build
+GENERAL_BUILD = ONE_PLANE_BUILD = None
+
+
+def _dispatch(body_vertices, pose, planes, vertex_planes, active, area, law, wear_direction,
+              contact_state, tangential, normal_force,
+              friction_work, wear_depth, wear_volume, wrench):
+    """The kernel: GENERAL_BUILD, or ONE_PLANE_BUILD for one analytic plane
+    and no mesh surface (the same computation, compiled for that case)."""
+    if planes.shape[0] == 1 and vertex_planes.shape[0] == 0:
+        ONE_PLANE_BUILD(body_vertices, pose, planes, vertex_planes, active, area, law,
+                        wear_direction, contact_state, tangential, normal_force,
+                        friction_work, wear_depth, wear_volume, wrench)
+    else:
+        GENERAL_BUILD(body_vertices, pose, planes, vertex_planes, active, area, law,
+                      wear_direction, contact_state, tangential, normal_force,
+                      friction_work, wear_depth, wear_volume, wrench)
+
+
+def _named_copy(fn, name, **constants):
+    """The same function under another name, ``constants`` added to (or
+    replacing) its module globals. numba's on-disk cache is keyed by the
+    qualified name, so each build needs its own; numba compiles globals as
+    constants, so ``ONE_PLANE=True`` gives the specialised build."""
+    copy = types.FunctionType(fn.__code__, dict(fn.__globals__, **constants), name,
+                              fn.__defaults__, fn.__closure__)
     copy.__qualname__ = name
     return copy
 
@@ -341,11 +392,26 @@ def _named_copy(fn, name):
 # instead of two, +20% here). Results stay deterministic on a machine but may
 # differ in the last bits between CPUs with and without FMA; NaN and infinity
 # keep their IEEE meaning (no "nnan"/"ninf"), so non-finite states are still
-# caught downstream.
+# caught downstream. error_model="numpy": a division by zero gives inf or NaN
+# (IEEE) instead of raising ZeroDivisionError, which drops a test and a branch
+# per division (+9 %); the kernel divides only by a contact area above FACING
+# times its length, by a slip speed checked > 0 and by the length of a last
+# slip velocity a reversal has just found non-zero.
 _FLAGS = {"contract"}
-contact_serial = njit(cache=True, fastmath=_FLAGS)(_named_copy(_contact, "contact_serial"))
-contact_parallel = njit(cache=True, parallel=True, fastmath=_FLAGS)(
-    _named_copy(_contact, "contact_parallel"))
+
+
+def _build(name, parallel):
+    """``name``: the kernel, serial or threaded, dispatching to its general
+    build or to the one compiled for one analytic plane and no mesh surface."""
+    options = dict(cache=True, fastmath=_FLAGS, error_model="numpy", parallel=parallel)
+    general = njit(**options)(_named_copy(_contact, name + "_general"))
+    one_plane = njit(**options)(_named_copy(_contact, name + "_one_plane", ONE_PLANE=True))
+    return njit(cache=True)(_named_copy(_dispatch, name, GENERAL_BUILD=general,
+                                        ONE_PLANE_BUILD=one_plane))
+
+
+contact_serial = _build("contact_serial", parallel=False)
+contact_parallel = _build("contact_parallel", parallel=True)
 
 
 def contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear_direction,

@@ -33,7 +33,6 @@ bounds : (16,)
 import numpy as np
 from numba import njit
 
-from .contact import rotation_entries
 from .rigid import path_point
 
 MOTION_SIZE = 19
@@ -201,4 +200,4 @@ def plane_rows(motion, terms, normal0, point0, t, buffer, out):
 
 
 __all__ = ["MOTION_SIZE", "BOUNDS_SIZE", "surface_frame", "shape_shift", "shape_speed",
-           "step_motion", "moved_since_refresh", "plane_rows", "rotation_entries"]
+           "step_motion", "moved_since_refresh", "plane_rows", "offset", "to_frame"]

@@ -39,8 +39,8 @@ in ParaView).
 
 import numpy as np
 
-from ..kernels.frames import (BOUNDS_SIZE, CONSTANT, LEVER, MOTION_SIZE, NORMAL, PROJECTION,
-                              RATE, UNIFORM, surface_frame)
+from ..kernels.frames import (BOUNDS_SIZE, CONSTANT, LEVER, NORMAL, PROJECTION, RATE, UNIFORM,
+                              surface_frame)
 from ..kernels.contact import rotation_entries
 from ..motion import Path
 
@@ -86,7 +86,6 @@ class SurfaceMotion:
         #: (19,) the kernels' ``motion`` array
         self.array = np.concatenate([self.R0.ravel(), self.position, self.axis, [self.rate],
                                      self.center])
-        assert self.array.shape == (MOTION_SIZE,)
         self.buffer = np.zeros((2, 3))
 
     @property
