@@ -1,9 +1,14 @@
-"""The step loop. :func:`step` fixes the phase order; :func:`run` drives it and
-calls the observers (recorders) at the sample and frame times.
+"""The step loop. :func:`step_body` fixes the phase order of a step of one
+body; :func:`run` drives the steps and calls the observers (recorders) at the
+sample and frame times.
 
-Phase order of one step, for every body: contact -> normal force -> friction
--> energy -> wear -> geometry update (one fused kernel, DESIGN.md §1), then
-the dynamics of every body from the contact wrench just computed.
+Phase order of one step of a body: the surfaces at the step's time and the
+active-set check, then contact -> normal force -> friction -> energy -> wear
+-> geometry update (one fused kernel, docs/model.md), then the body's motion
+from the contact wrench just computed (quasi-static: placed on its path and
+in load balance first). Runs take their steps in the compiled loop
+(:mod:`meshwear.stepper`), which runs the same kernels in the same order;
+:func:`step` is its Python reference.
 """
 
 import numpy as np

@@ -265,10 +265,11 @@ def closest_points(tri, points):
 
 
 def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-                   face_normals, corner_normals, reach, out, distance, hint, tracking=0.5,
-                   tie=1e-9):
+                   face_normals, corner_normals, reach, out, distance, hint, fixed=False,
+                   tracking=0.5, tie=1e-9):
     """Same contract as :func:`meshwear.kernels.nearest.nearest_planes`, by
-    brute force over every face (no grid)."""
+    brute force over every face (no grid); ``fixed`` only lets the kernel
+    reuse what it wrote, so the twin ignores it."""
     R = quaternion_matrix(pose[3:7])
     x = pose[0:3] + body_vertices[active] @ R.T
     y = (x - motion[0]) @ rotation

@@ -82,8 +82,20 @@ def test_nearest_planes_match_brute_force_twin(smooth):
     assert 0.3 < found.mean() < 1.0, "the case must have vertices in and out of reach"
     inactive = np.setdiff1d(np.arange(n), active)
     assert (distance[inactive] == -1.0).all()
-    # the next step, the body moved a little: each vertex starts from the
-    # face it had (a third of them from a wrong one), kept while it is over it
+    # the next step, the body moved a little: each vertex keeps the face it
+    # had while it is over it; the surface did not turn, so it may keep the
+    # normal it holds (fixed)
+    fixed_out, fixed_twin = out.copy(), out.copy()
+    fixed_hint, fixed_twin_hint = hint.copy(), hint.copy()
+    moved = pose.copy()
+    moved[0:3] += [3e-4, -2e-4, 1e-4]
+    nearest.nearest_planes(body, moved, active, rotation, motion, V, F, frames, vnormals, *grid,
+                           fixed_out, distance, fixed_hint, True)
+    reference.nearest_planes(body, moved, active, rotation, motion, V, F, normals, vnormals,
+                             reach, fixed_twin, twin_distance, fixed_twin_hint)
+    assert _close(fixed_out, fixed_twin) and _close(distance, twin_distance)
+    assert (fixed_hint == fixed_twin_hint).all()
+    # and, a third of them starting from a wrong face, without that promise
     pose[0:3] += [3e-4, -2e-4, 1e-4]
     stale = rng.random(n) < 0.3
     hint[stale] = rng.integers(0, len(F), stale.sum())

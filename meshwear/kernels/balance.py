@@ -39,10 +39,19 @@ def _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law, 
     n_planes = planes.shape[0]
     count = 0
     for s in range(n_planes + vertex_planes.shape[0]):
+        m = s - n_planes
         for k in range(active.shape[0]):
             i = active[k]
-            plane = planes[s] if s < n_planes else vertex_planes[s - n_planes, i]
-            nx, ny, nz = plane[1, 0], plane[1, 1], plane[1, 2]
+            # the plane's point and normal, read as scalars (a view per pair
+            # would cost a reference count)
+            if s < n_planes:
+                ox, oy, oz = planes[s, 0, 0], planes[s, 0, 1], planes[s, 0, 2]
+                nx, ny, nz = planes[s, 1, 0], planes[s, 1, 1], planes[s, 1, 2]
+            else:
+                ox, oy = vertex_planes[m, i, 0, 0], vertex_planes[m, i, 0, 1]
+                oz = vertex_planes[m, i, 0, 2]
+                nx, ny = vertex_planes[m, i, 1, 0], vertex_planes[m, i, 1, 1]
+                nz = vertex_planes[m, i, 1, 2]
             beta = axis[0] * nx + axis[1] * ny + axis[2] * nz
             if beta == 0.0:
                 continue
@@ -59,7 +68,7 @@ def _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law, 
             px = pose[0] + r00 * bx + r01 * by + r02 * bz
             py = pose[1] + r10 * bx + r11 * by + r12 * bz
             pz = pose[2] + r20 * bx + r21 * by + r22 * bz
-            delta = (px - plane[0, 0]) * nx + (py - plane[0, 1]) * ny + (pz - plane[0, 2]) * nz
+            delta = (px - ox) * nx + (py - oy) * ny + (pz - oz) * nz
             breakpoint[count] = -delta / beta
             weight[count] = c * beta * beta * (1.0 if beta > 0.0 else -1.0)
             if scale.shape[0]:

@@ -51,14 +51,16 @@ def fill_planes(surface, t, body_vertices, pose, active, out, distance, hint, bu
     surface_frame(motion, terms, t, frozen, buffer, rotation, frame)
     threads = active.shape[0] >= PARALLEL_THRESHOLD
     if kind == MESH:
+        # the frame turns only for a turning surface that is not frozen
+        fixed = frozen or motion[15] == 0.0
         if threads:
             nearest_planes_parallel(body_vertices, pose, active, rotation, frame,
                                     counter_vertices, faces, frames, corner_normals, grid, keys,
-                                    starts, items, out, distance, hint)
+                                    starts, items, out, distance, hint, fixed)
         else:
             nearest_planes_serial(body_vertices, pose, active, rotation, frame, counter_vertices,
                                   faces, frames, corner_normals, grid, keys, starts, items, out,
-                                  distance, hint)
+                                  distance, hint, fixed)
     elif kind == CYLINDER:
         if threads:
             cylinder_planes_parallel(body_vertices, pose, active, rotation, frame, geometry, out,

@@ -1,7 +1,7 @@
 """The counter face under each vertex: nearest-face queries on a mesh counter-surface.
 
 A mesh counter-surface gives each vertex of a worn body the plane of its
-nearest face (DESIGN.md §1 is then the same point-plane contact). The faces
+nearest face (docs/model.md: then the same point-plane contact). The faces
 are binned once, in the counter-surface's own frame, into a uniform grid whose
 cells list every face within ``reach`` of any point of the cell
 (:func:`build_grid`); a query looks up the one cell holding the point, so it
@@ -123,14 +123,23 @@ def _along(frames, f, row, x, y, z):
 
 
 def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-                    frames, corner_normals, grid, keys, starts, items, out, distance, hint):
+                    frames, corner_normals, grid, keys, starts, items, out, distance, hint,
+                    fixed):
     r = rotation_entries(pose[3:7])
     smooth = corner_normals.shape[0] > 0
+    flat = not smooth
     reach2 = grid[7] * grid[7]
     over = OVER * grid[7]
     grow = 1.0 + 2.0 * TIE
+    # the counter frame's origin, velocity, turn and its centre, as scalars
+    # (read once, not again after each write to out)
+    o0, o1, o2 = motion[0, 0], motion[0, 1], motion[0, 2]
+    v0, v1, v2 = motion[1, 0], motion[1, 1], motion[1, 2]
+    w0, w1, w2 = motion[2, 0], motion[2, 1], motion[2, 2]
+    c0, c1, c2 = motion[3, 0], motion[3, 1], motion[3, 2]
     for k in prange(active.shape[0]):
-        i = active[k]
+        # unsigned, so that indexing skips numpy's negative-index wrap-around
+        i = np.uint64(active[k])
         # world position, then counter frame: y = Rc^T (x - origin)
         ex, ey, ez = offset(r, pose, body_vertices, i, motion)
         yx, yy, yz = to_frame(rotation, ex, ey, ez)
@@ -139,7 +148,9 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
         ox, oy, oz = out[i, 1, 0], out[i, 1, 1], out[i, 1, 2]
         tracked = ox != 0.0 or oy != 0.0 or oz != 0.0
         # the previous normal in the counter frame
-        tx, ty, tz = to_frame(rotation, ox, oy, oz)
+        tx, ty, tz = 0.0, 0.0, 0.0
+        if tracked and not (fixed and flat):
+            tx, ty, tz = to_frame(rotation, ox, oy, oz)
         # the nearest face, and the nearest of the faces the vertex can stay
         # on (within TRACKING of its last normal, and with the vertex over
         # it, not beyond its edges: past a convex edge the vertex lets go)
@@ -147,6 +158,7 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
         best_d2 = kept_d2 = np.inf
         best_delta = kept_delta = -np.inf
         lo, hi = 0, -1
+        by_hint = False
         h = hint[i]
         if tracked and h >= 0:
             # still over the face it had, within reach and TRACKING: it stays
@@ -155,10 +167,16 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             delta = _along(frames, h, 0, yx, yy, yz)
             outside = max(_along(frames, h, 1, yx, yy, yz), _along(frames, h, 2, yx, yy, yz),
                           _along(frames, h, 3, yx, yy, yz))
+            # (a flat face of a surface that does not turn in its frame: the
+            # normal the vertex holds is that face's own, TRACKING holds)
             if (delta * delta <= reach2 and outside <= over
-                    and _along(frames, h, 0, tx, ty, tz) + frames[h, 0, 3] >= TRACKING):
+                    and ((fixed and flat)
+                         or _along(frames, h, 0, tx, ty, tz) + frames[h, 0, 3] >= TRACKING)):
                 kept, kept_d2, kept_delta = h, delta * delta, delta
+                by_hint = True
         if kept < 0:
+            if tracked and fixed and flat:
+                tx, ty, tz = to_frame(rotation, ox, oy, oz)
             lo, hi = _cell_range(yx, yy, yz, grid, keys, starts)
         for j in range(lo, hi):
             f = items[j]
@@ -203,7 +221,8 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
                     out[i, row, col] = 0.0
             distance[i] = np.inf
             continue
-        distance[i] = np.sqrt(best_d2)
+        # over its face, a vertex's distance to it is its distance to the plane
+        distance[i] = abs(best_delta) if by_hint else np.sqrt(best_d2)
         hx, hy, hz = frames[best, 0, 0], frames[best, 0, 1], frames[best, 0, 2]
         if smooth:
             # the normal interpolated at the closest point of the face
@@ -224,17 +243,24 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             # that is inside the face)
             qx, qy, qz = yx - best_delta * hx, yy - best_delta * hy, yz - best_delta * hz
         # back to the world: point, normal, and the counter-surface's velocity there
-        px = rotation[0, 0] * qx + rotation[0, 1] * qy + rotation[0, 2] * qz + motion[0, 0]
-        py = rotation[1, 0] * qx + rotation[1, 1] * qy + rotation[1, 2] * qz + motion[0, 1]
-        pz = rotation[2, 0] * qx + rotation[2, 1] * qy + rotation[2, 2] * qz + motion[0, 2]
+        if by_hint and fixed and flat:
+            # the same face, the same frame: the normal it holds, its foot
+            # straight from its world position
+            px = ex + o0 - best_delta * ox
+            py = ey + o1 - best_delta * oy
+            pz = ez + o2 - best_delta * oz
+        else:
+            px = rotation[0, 0] * qx + rotation[0, 1] * qy + rotation[0, 2] * qz + o0
+            py = rotation[1, 0] * qx + rotation[1, 1] * qy + rotation[1, 2] * qz + o1
+            pz = rotation[2, 0] * qx + rotation[2, 1] * qy + rotation[2, 2] * qz + o2
+            out[i, 1, 0] = rotation[0, 0] * hx + rotation[0, 1] * hy + rotation[0, 2] * hz
+            out[i, 1, 1] = rotation[1, 0] * hx + rotation[1, 1] * hy + rotation[1, 2] * hz
+            out[i, 1, 2] = rotation[2, 0] * hx + rotation[2, 1] * hy + rotation[2, 2] * hz
         out[i, 0, 0], out[i, 0, 1], out[i, 0, 2] = px, py, pz
-        out[i, 1, 0] = rotation[0, 0] * hx + rotation[0, 1] * hy + rotation[0, 2] * hz
-        out[i, 1, 1] = rotation[1, 0] * hx + rotation[1, 1] * hy + rotation[1, 2] * hz
-        out[i, 1, 2] = rotation[2, 0] * hx + rotation[2, 1] * hy + rotation[2, 2] * hz
-        lx, ly, lz = px - motion[3, 0], py - motion[3, 1], pz - motion[3, 2]
-        out[i, 2, 0] = motion[1, 0] + motion[2, 1] * lz - motion[2, 2] * ly
-        out[i, 2, 1] = motion[1, 1] + motion[2, 2] * lx - motion[2, 0] * lz
-        out[i, 2, 2] = motion[1, 2] + motion[2, 0] * ly - motion[2, 1] * lx
+        lx, ly, lz = px - c0, py - c1, pz - c2
+        out[i, 2, 0] = v0 + w1 * lz - w2 * ly
+        out[i, 2, 1] = v1 + w2 * lx - w0 * lz
+        out[i, 2, 2] = v2 + w0 * ly - w1 * lx
 
 
 def face_frames(vertices, faces):
@@ -258,9 +284,10 @@ def face_frames(vertices, faces):
 
 
 # fastmath "contract" only, as the contact kernel (FMA; IEEE NaN and infinity kept)
-nearest_planes_serial = njit(cache=True, fastmath={"contract"})(
+nearest_planes_serial = njit(cache=True, fastmath={"contract"}, error_model="numpy")(
     _named_copy(_nearest_planes, "nearest_planes_serial"))
-nearest_planes_parallel = njit(cache=True, parallel=True, fastmath={"contract"})(
+nearest_planes_parallel = njit(cache=True, parallel=True, fastmath={"contract"},
+                               error_model="numpy")(
     _named_copy(_nearest_planes, "nearest_planes_parallel"))
 
 #: active vertices from which the threaded query pays for its threads
@@ -268,7 +295,8 @@ PARALLEL_THRESHOLD = 2048
 
 
 def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-                   frames, corner_normals, grid, keys, starts, items, out, distance, hint):
+                   frames, corner_normals, grid, keys, starts, items, out, distance, hint,
+                   fixed=False):
     """For each ``active`` vertex ``i`` of a body at ``pose``, write to
     ``out[i]`` (3, 3) the plane of its nearest counter face within the grid's
     reach (``grid[7]``) (point, normal, counter velocity there; world), to
@@ -276,11 +304,14 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
     face's index; zeros, ``inf`` and -1 where no face qualifies. A vertex that
     had a plane (``out[i]`` nonzero on entry) keeps to faces whose normal is
     within 60 degrees of the one it had while it is over one of them
-    (:data:`TRACKING`), and to face ``hint[i]`` itself while it is over it."""
+    (:data:`TRACKING`), and to face ``hint[i]`` itself while it is over it.
+    ``fixed``: the surface's ``rotation`` is the one of the call that filled
+    ``out`` (a fixed or frozen surface), so a vertex that keeps its face
+    keeps the normal it holds."""
     kernel = (nearest_planes_parallel if active.shape[0] >= PARALLEL_THRESHOLD
               else nearest_planes_serial)
     kernel(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-           frames, corner_normals, grid, keys, starts, items, out, distance, hint)
+           frames, corner_normals, grid, keys, starts, items, out, distance, hint, fixed)
 
 
 #: faces meeting at a vertex at more than 60 degrees are a crease: smoothed
