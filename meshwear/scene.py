@@ -21,13 +21,13 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .kernels.laws import LAWS
 from .scene_checks import (SceneError, _boolean, _choice, _did_you_mean, _direction, _exclusive,
                            _instance, _integer, _name, _nonnegative, _positive, _real, _set,
                            _set_optional, _show, _vector)
 
 FORMAT = 1
 MODES = ("dynamic", "quasi-static")
-WEAR_LAWS = ("energy", "energy_density", "archard")
 WEAR_DIRECTIONS = ("contact_normal", "vertex_normal")
 ACCELERATIONS = ("none", "cycle_jump")
 JUMPS = ("implicit", "explicit")
@@ -179,7 +179,7 @@ class WearConfig:
     jump: str = "implicit"
 
     def __post_init__(self):
-        _set(self, "law", _choice, WEAR_LAWS)
+        _set(self, "law", _choice, tuple(LAWS))
         _set(self, "coefficient", _nonnegative)
         _set(self, "direction", _choice, WEAR_DIRECTIONS)
         _set(self, "acceleration", _choice, ACCELERATIONS)

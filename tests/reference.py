@@ -1,14 +1,21 @@
 """Plain-numpy twins of the numba kernels, written array-at-a-time.
 
-They follow DESIGN.md §1 directly and share no code with meshwear.kernels, so
-agreement between the two is evidence about both. The benchmark imports the
+They follow docs/model.md directly and share no code with meshwear.kernels
+but the wear laws' numpy twins, which the law registry keeps beside the
+increments they twin (meshwear/kernels/laws.py), so agreement between the two
+is evidence about both. The benchmark imports the
 contact twin as its same-run reference.
 """
 
 import numpy as np
 
+from meshwear.kernels.laws import LAWS
+
 NO_CONTACT, STICK, SLIP = 0, 1, 2
-ENERGY, ENERGY_DENSITY, ARCHARD = 0, 1, 2
+#: law code -> numpy twin of its increment (the twins live beside the
+#: increments in the registry; the kernel's dispatch on codes is what this
+#: checks)
+LAW_TWINS = {law.code: law.twin for law in LAWS.values()}
 
 
 def quaternion_matrix(q):
@@ -105,15 +112,10 @@ def contact(body_vertices, pose, planes, vertex_planes, active, area_vectors, la
         slip_force = np.where((v_norm > 0.0)[:, None], -(f * load / safe)[:, None] * v_old, 0.0)
         F = np.where(stick[:, None], trial, np.where(slip[:, None], slip_force, 0.0))
         energy = np.where(stick, dtan * speed ** 2 * dt, np.where(slip, f * load * speed * dt, 0.0))
-        if wear_law == ENERGY:
-            dw = k * energy
-            dv = dw * area
-        elif wear_law == ENERGY_DENSITY:
-            dv = k * energy
-            dw = dv / safe_area
-        else:
-            dv = np.where(slip, k * load * speed * dt, 0.0)
-            dw = dv / safe_area
+        # the law's numpy twin from the registry (it twins the increment
+        # the kernel inlines); the slip distance is zero where it sticks
+        dw, dv = LAW_TWINS[wear_law](k, energy, load, np.where(slip, speed * dt, 0.0), safe_area)
+        dw, dv = np.where(touching, dw, 0.0), np.where(touching, dv, 0.0)
 
         direction = wear_direction if wear_direction.shape[0] else n @ R
         if wear_direction.shape[0]:

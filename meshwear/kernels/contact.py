@@ -37,8 +37,8 @@ area : (n, 4)
     ``A_i = -(R a_i) . n``, its tributary area projected on the plane; a
     vertex with ``A_i`` below :data:`FACING` of its length does not touch.
 law : (13,)
-    ``f``, ``f0``, wear law code (:data:`ENERGY`, :data:`ENERGY_DENSITY`,
-    :data:`ARCHARD`), wear coefficient ``k``, time step ``dt`` (s), then the
+    ``f``, ``f0``, wear law code (:data:`meshwear.kernels.laws.LAWS`), wear
+    coefficient ``k``, time step ``dt`` (s), then the
     contact coefficients as (per point, per area) pairs: normal stiffness,
     normal damping, tangential stiffness, tangential damping. Point ``i`` gets
     ``c_i = c_point + c_area A_i`` (N/m), ``A_i`` the contact area, and likewise ``d_i``, ``c_t,i``,
@@ -71,9 +71,13 @@ import types
 import numpy as np
 from numba import njit, prange
 
+from . import laws
+from .laws import wear_increment
+
 NO_CONTACT, STICK, SLIP = 0, 1, 2
-ENERGY, ENERGY_DENSITY, ARCHARD = 0, 1, 2
-WEAR_LAWS = {"energy": ENERGY, "energy_density": ENERGY_DENSITY, "archard": ARCHARD}
+#: law codes (the registry, :data:`meshwear.kernels.laws.LAWS`, is the list)
+ENERGY, ENERGY_DENSITY, ARCHARD = (laws.code_of(name) for name in ("energy", "energy_density",
+                                                                   "archard"))
 
 #: slots of ``tangential[s, i]``
 ANCHOR, START_FORCE, FORCE, SLIP_VELOCITY = 0, 1, 2, 3
@@ -90,9 +94,9 @@ def make_law(*, friction, static_friction, wear_law, wear_coefficient, dt,
              tangential_stiffness=0.0, tangential_stiffness_per_area=0.0,
              tangential_damping=0.0, tangential_damping_per_area=0.0):
     """The ``law`` array of the kernel from named values (``wear_law``: a code
-    of :data:`WEAR_LAWS` or its name)."""
+    of :data:`meshwear.kernels.laws.LAWS` or its name)."""
     if isinstance(wear_law, str):
-        wear_law = WEAR_LAWS[wear_law]
+        wear_law = laws.code_of(wear_law)
     values = dict(locals())
     return np.array([float(values[name]) for name in LAW_SLOTS])
 
@@ -312,18 +316,9 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
             tangential[s, i, FORCE, 0] = Fx
             tangential[s, i, FORCE, 1] = Fy
             tangential[s, i, FORCE, 2] = Fz
-            # eq. 5 and variants: wear depth and volume increments
-            if wear_law == ENERGY:
-                dw = k * energy
-                dv = dw * a
-            elif wear_law == ENERGY_DENSITY:
-                dv = k * energy
-                dw = dv / a
-            elif state == SLIP:
-                dv = k * load * speed * dt
-                dw = dv / a
-            else:
-                dw = dv = 0.0
+            # eq. 5 and variants: wear depth and volume increments of the
+            # law (meshwear.kernels.laws; speed is zero unless it slips)
+            dw, dv = wear_increment(wear_law, k, energy, load, speed * dt, a)
             friction_work[i] += energy
             if dw > 0.0:
                 wear_depth[i] += dw
