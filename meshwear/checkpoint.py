@@ -23,6 +23,8 @@ FILE_NAME = "checkpoint.npz"
 _BODY_ARRAYS = ("pose", "vertices", "wear_depth", "friction_work", "wear_volume",
                 "contact_state", "tangential", "normal_force", "wrench", "vertex_planes", "hint",
                 "cull")
+#: what a worn counter-surface's state holds (meshwear.model.PartState)
+_PART_ARRAYS = ("vertices", "frames", "depth", "volume", "work")
 
 
 def scene_digest(scene):
@@ -46,6 +48,10 @@ def save(path, model, state, wall_time):
             arrays[f"body{k}_{name}"] = getattr(s, name)
         arrays[f"body{k}_active"] = s.active
         arrays[f"body{k}_active_wear"] = s.active_wear
+    for m, part in enumerate(state.parts):
+        if part is not None:
+            for name in _PART_ARRAYS:
+                arrays[f"part{m}_{name}"] = getattr(part, name)
     js = state.jump
     if js is not None:
         arrays["jump_scalars"] = np.array([js.gap, js.last_jump, js.jumps, js.resolved_steps,
@@ -109,6 +115,11 @@ def load(path, model, state):
                 getattr(s, name)[...] = data[f"body{k}_{name}"]
             s.active = data[f"body{k}_active"].astype(np.int64)
             s.active_wear = data[f"body{k}_active_wear"].copy()
+        # in place: the worn surfaces query and draw these very arrays
+        for m, part in enumerate(state.parts):
+            if part is not None:
+                for name in _PART_ARRAYS:
+                    getattr(part, name)[...] = data[f"part{m}_{name}"]
     except (KeyError, ValueError) as err:
         raise SceneError(model.scene.source, "", f"{path} was written by another version of "
                          f"meshwear ({err}); run without --resume to start again") from None

@@ -11,6 +11,9 @@ import numpy as np
 
 from . import geometry, surfaces
 from .kernels.contact import LAW_SLOTS, all_vertices, contact, make_law, rotation_entries
+from .kernels.counter_wear import wear_counter
+from .kernels.laws import code_of
+from .kernels.nearest import face_frames
 from .motion import BalancedMotion, FixedMotion, FreeMotion, GuidedMotion, Path, PrescribedMotion
 from .scene import SceneError
 
@@ -110,6 +113,11 @@ class Model:
         return self.n_steps * self.dt
 
     @property
+    def worn_counters(self):
+        """Some counter-surface wears."""
+        return bool(self.surfaces) and any(m.worn for m in self.surfaces.per_vertex)
+
+    @property
     def slots(self):
         """Number of counter-surfaces: planes, then the per-vertex ones."""
         return self.planes.shape[0] + (len(self.surfaces.per_vertex) if self.surfaces else 0)
@@ -168,6 +176,37 @@ class BodyState:
 
 
 @dataclass(eq=False)
+class PartState:
+    """What wear changes on a worn mesh counter-surface (its own frame).
+
+    Attributes
+    ----------
+    vertices : (V, 3) float
+        Worn vertices (m).
+    frames : (F, 4, 4) float
+        Their faces' frames (:func:`meshwear.kernels.nearest.face_frames`).
+    depth, volume, work : (V,) float
+        Wear depth (m), worn volume (m³) and friction work (J) per vertex.
+    added : (V,) float
+        Scratch of :func:`meshwear.kernels.counter_wear.wear_counter` (zeros).
+    """
+
+    vertices: np.ndarray
+    frames: np.ndarray
+    depth: np.ndarray
+    volume: np.ndarray
+    work: np.ndarray
+    added: np.ndarray
+
+    @classmethod
+    def unworn(cls, surface):
+        n = len(surface.reference_vertices)
+        return cls(vertices=surface.reference_vertices.copy(),
+                   frames=face_frames(surface.reference_vertices, surface.faces),
+                   depth=np.zeros(n), volume=np.zeros(n), work=np.zeros(n), added=np.zeros(n))
+
+
+@dataclass(eq=False)
 class State:
     """Where a run is: ``step`` steps of ``dt`` represented (``time``), the
     bodies' state, the last step whose outputs are written, the cycle
@@ -181,6 +220,8 @@ class State:
     jump: object = None
     #: False from a cycle jump until the next step: the state is extrapolated
     resolved: bool = True
+    #: per per-vertex surface, its :class:`PartState` if it wears, else None
+    parts: list = field(default_factory=list)
 
 
 def build_model(scene):
@@ -198,6 +239,14 @@ def build_model(scene):
         except geometry.MeshError as err:
             key = f"surface[{j}].mesh" if s.mesh is not None else f"surface[{j}].shape"
             raise SceneError(scene.source, key, str(err)) from None
+    for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
+        if getattr(s, "wear", False):
+            if scene.wear.acceleration == "cycle_jump":
+                raise SceneError(scene.source, f"surface[{j}].wear",
+                                 "a worn counter-surface cannot be cycle-jumped yet; run it "
+                                 "resolved (wear.acceleration = 'none')")
+            surface.make_worn(code_of(s.law or scene.wear.law),
+                              scene.wear.coefficient if s.coefficient is None else s.coefficient)
     surface_set = surfaces.SurfaceSet(built)
     plane_array = surface_set.planes
 
@@ -421,7 +470,11 @@ def initial_state(model):
             active=all_vertices(n), active_wear=np.zeros(n), cull=np.zeros(surfaces.CULL_SIZE),
             cull_scratch=surfaces.Cull(np.zeros(n), np.zeros((n, 3, 3)) if M else None,
                                        np.full(n, -1, dtype=np.int64))))
-    state = State(time=0.0, step=0, bodies=bodies)
+    parts = [PartState.unworn(m) if m.worn else None for m in model.surfaces.per_vertex]
+    for m, part in zip(model.surfaces.per_vertex, parts):
+        if part is not None:
+            m.attach(part)
+    state = State(time=0.0, step=0, bodies=bodies, parts=parts)
     for body, s in zip(model.bodies, state.bodies):
         surfaces.update(model, body, s, 0.0)
     if model.quasi_static:
@@ -440,6 +493,24 @@ def body_contact(model, body, s):
     contact(s.vertices, s.pose, model.planes, s.vertex_planes, s.active, body.area_vectors,
             model.law, body.wear_direction, s.contact_state, s.tangential, s.normal_force,
             s.friction_work, s.wear_depth, s.wear_volume, s.wrench)
+
+
+def wear_counters(model, body, s, t):
+    """The wear of the worn counter-surfaces by the step of ``body`` just
+    taken at ``t`` (:func:`meshwear.kernels.counter_wear.wear_counter`).
+    Returns None, or ``(surface, vertex)``: a counter vertex that sank
+    deeper than its mesh can follow in that step."""
+    P = model.planes.shape[0]
+    for m, surface in enumerate(model.surfaces.per_vertex):
+        if surface.worn:
+            rotation, frame = surface.frame(t)
+            worst = wear_counter(s.vertices, s.pose, s.active, body.area_vectors, model.law,
+                                 s.contact_state[P + m], s.normal_force[P + m],
+                                 s.vertex_planes[m], s.hint[m], rotation, frame,
+                                 surface.part_tuple())
+            if worst >= 0:
+                return surface, worst
+    return None
 
 
 def stable_time_step(model):

@@ -43,7 +43,7 @@ SHAPE_REQUIRED = {"box": ("size",), "sphere": ("radius",), "cylinder": ("radius"
 SURFACE_KEYS = {
     "plane": ("point", "normal", "size", "rotation", "path"),
     "mesh": ("mesh", "shape", "units", "resolution", "position", "orientation", "rotation",
-             "path", "smooth_normals"),
+             "path", "smooth_normals", "wear", "law", "coefficient"),
     "cylinder": ("radius", "axis", "point", "length", "side", "rotation", "path"),
     "sphere": ("radius", "center", "side", "rotation", "path"),
 }
@@ -365,7 +365,8 @@ class SurfaceConfig:
     ``side`` ("outside": a shaft or ring, "inside": a bore).
     ``type = "sphere"``: ``radius``, ``center`` and ``side`` (a ball, or a cup).
     ``type = "mesh"``: mesh or shape, units, resolution, position, orientation as
-    for a body, and ``smooth_normals``.
+    for a body, and ``smooth_normals``. ``wear = true`` makes it wear too, by
+    its own ``law`` and ``coefficient`` (None: those of ``[wear]``).
     """
 
     name: str
@@ -388,6 +389,11 @@ class SurfaceConfig:
     path: PathConfig | None = None
     #: interpolate vertex normals over the face under a vertex (curved parts)
     smooth_normals: bool = False
+    #: a mesh counter-part that wears, by its own law and coefficient (None:
+    #: the [wear] ones, filled in by the Scene)
+    wear: bool = False
+    law: str | None = None
+    coefficient: float | None = None
 
     def __post_init__(self):
         _set(self, "name", _name)
@@ -405,6 +411,13 @@ class SurfaceConfig:
                 raise SceneError("", key, f'does not apply to a type = "{self.type}" surface')
         if self.type == "mesh":
             _check_mesh_or_shape(self)
+            _set(self, "wear", _boolean)
+            _set_optional(self, "law", _choice, tuple(LAWS))
+            _set_optional(self, "coefficient", _nonnegative)
+            for key in ("law", "coefficient"):
+                if getattr(self, key) is not None and not self.wear:
+                    raise SceneError("", key, "applies to a worn surface only; "
+                                              "add wear = true")
             return
         _set(self, "point", _vector)
         _set(self, "center", _vector)

@@ -15,7 +15,7 @@ import numpy as np
 
 from . import stepper, surfaces
 from .geometry import inverted_faces
-from .model import body_contact
+from .model import body_contact, wear_counters
 from .output.memory import MemoryHistory
 
 
@@ -44,7 +44,7 @@ def step_body(model, body, s, k):
         return
     t = k * model.dt
     surfaces.update(model, body, s, t)
-    touch(model, body, s)
+    touch(model, body, s, t)
     body.motion.advance(s.pose, s.wrench, t, model.dt)
 
 
@@ -71,22 +71,36 @@ def _quasi_static_step(model, body, s, k):
         if surfaces.moved_since_refresh(model, body, s, t) >= s.cull[surfaces.CULL_MARGIN]:
             finish_step(model, body, s, t)
             return
-    touch(model, body, s)
+    touch(model, body, s, t)
 
 
 def finish_step(model, body, s, t):
     """The rest of a quasi-static step whose settling move reached the
     active-set bound: refresh, planes at ``t``, contact."""
     surfaces.update(model, body, s, t)
-    touch(model, body, s)
+    touch(model, body, s, t)
 
 
-def touch(model, body, s):
-    """One step of the contact kernel, and the normal forces added to ``s.load`` if kept."""
+def touch(model, body, s, t):
+    """One step of the contact kernel at ``t``, the normal forces added to
+    ``s.load`` if kept, and the wear of worn counter-surfaces."""
     body_contact(model, body, s)
     if len(s.load):
         a = s.active
         s.load[a] += s.normal_force[:, a].sum(axis=0)
+    if model.worn_counters:
+        too_deep = wear_counters(model, body, s, t)
+        if too_deep is not None:
+            raise counter_too_deep(model, *too_deep, t)
+
+
+def counter_too_deep(model, surface, vertex, t):
+    """The error of a counter vertex worn deeper than its mesh can follow."""
+    return NumericalError(
+        f"surface {surface.name!r}: vertex {vertex} wore {surface.part.depth[vertex]:.3g} m deep, "
+        f"more than half its shortest edge ({surface.spacing[vertex]:.3g} m) in the step to "
+        f"t = {t:.6g} s: refine the surface (resolution), lower its wear coefficient or "
+        "shorten run.dt")
 
 
 def no_balance(body, t):

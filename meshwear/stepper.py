@@ -33,28 +33,41 @@ def _motion_arrays(model, body, s):
 
 
 def advance(model, state, until):
-    """Step every body of ``state`` from ``state.step`` to step ``until``."""
-    from .simulate import finish_step, no_balance, step_body
+    """Step every body of ``state`` from ``state.step`` to step ``until``
+    (bodies that share a worn counter-surface in turn, a step each)."""
+    if model.worn_counters and len(model.bodies) > 1:
+        for k in range(state.step, until):
+            _advance_bodies(model, state, k, k + 1)
+    else:
+        _advance_bodies(model, state, state.step, until)
+    state.step = until
+    state.time = until * model.dt
+
+
+def _advance_bodies(model, state, start, until):
+    from .simulate import counter_too_deep, finish_step, no_balance, step_body
 
     dt = model.dt
     surfaces = model.surfaces
     planes = surfaces.compiled_planes()
+    report = np.zeros(2, np.int64)
     for body, s in zip(model.bodies, state.bodies):
-        k = state.step
+        k = start
         while k < until:
             k, what = loop.advance_body(k, until, dt, model.quasi_static, model.cull,
                                         _body_arrays(model, body, s),
                                         _motion_arrays(model, body, s), planes,
                                         surfaces.compiled_list(), surfaces.bounds,
-                                        surfaces.terms)
+                                        surfaces.terms, report)
             if what == loop.DONE:
                 break
             if what == loop.REFRESH:
                 step_body(model, body, s, k)
             elif what == loop.FINISH:
                 finish_step(model, body, s, (k + 1) * dt)
+            elif what == loop.TOO_DEEP:
+                t = (k + 1) * dt if model.quasi_static else k * dt
+                raise counter_too_deep(model, surfaces.per_vertex[report[0]], report[1], t)
             else:
                 raise no_balance(body, (k + 1) * dt)
             k += 1
-    state.step = until
-    state.time = until * dt

@@ -376,3 +376,59 @@ def sphere_planes(body_vertices, pose, active, rotation, frame, geometry, out, d
     u = e / np.where(ok, r, 1.0)[:, None]
     _surface_planes(frame[0] + radius * u, sign * u, frame, sign * (r - radius), ok, active,
                     out, distance)
+
+
+def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, normal_force,
+                 planes, hint, rotation, frame, part):
+    """Same contract as :func:`meshwear.kernels.counter_wear.wear_counter`,
+    array at a time (the pairs' energy and slip from their velocities, the
+    law's twin, the closest-point weights of :func:`closest_points`); the
+    face frames are all recomputed. Returns the vertices that sank more than
+    half their spacing."""
+    (counter_law, faces, reference, normals, tributary, spacing, _, _, vertices, frames, depth,
+     volume, work, _) = part
+    code, k = int(counter_law[0]), counter_law[1]
+    f, dt, dt0, dt1 = law[0], law[4], law[11], law[12]
+    R = quaternion_matrix(pose[3:7])
+    i = active[(contact_state[active] != NO_CONTACT) & (normal_force[active] > 0.0)
+               & (hint[active] >= 0)]
+    n = planes[i, 1]
+    r = body_vertices[i] @ R.T
+    x = pose[0:3] + r
+    foot = x - _dot(x - planes[i, 0], n)[:, None] * n
+    a = contact_areas(area_vectors[i], R, n)
+    i, n, r, foot, a = i[a > 0.0], n[a > 0.0], r[a > 0.0], foot[a > 0.0], a[a > 0.0]
+    g = pose[7:10] + np.cross(pose[10:13], r) - planes[i, 2]
+    s = g - _dot(g, n)[:, None] * n
+    speed = np.linalg.norm(s, axis=1)
+    load = normal_force[i]
+    slipping = contact_state[i] == SLIP
+    energy = np.where(slipping, f * load * speed * dt, (dt0 + dt1 * a) * speed ** 2 * dt)
+    dv = LAW_TWINS[code](k, energy, load, np.where(slipping, speed * dt, 0.0), a)[1]
+    q = (foot - frame[0]) @ rotation
+    corners = faces[hint[i]]
+    _, weights = closest_points(vertices[corners], q)
+    before = depth.copy()
+    for c in range(3):
+        np.add.at(work, corners[:, c], weights[:, c] * energy)
+        np.add.at(volume, corners[:, c], weights[:, c] * dv)
+        np.add.at(depth, corners[:, c], weights[:, c] * dv / tributary[corners[:, c]])
+    moved = depth > before
+    vertices[moved] = reference[moved] - depth[moved, None] * normals[moved]
+    frames[...] = face_frames(vertices, faces)
+    return np.flatnonzero(depth - before > 0.5 * spacing)
+
+
+def face_frames(vertices, faces):
+    """(F, 4, 4) face planes and edge lines, as meshwear.kernels.nearest.face_frames."""
+    tri = vertices[faces]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    out = np.zeros((len(faces), 4, 4))
+    out[:, 0, 0:3], out[:, 0, 3] = n, _dot(n, tri[:, 0])
+    for e in range(3):
+        p, q = tri[:, e], tri[:, (e + 1) % 3]
+        m = np.cross(q - p, n)
+        m /= np.linalg.norm(m, axis=1)[:, None]
+        out[:, e + 1, 0:3], out[:, e + 1, 3] = m, _dot(m, p)
+    return out

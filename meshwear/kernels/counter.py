@@ -21,6 +21,9 @@ frozen : bool
     turn (the velocity field keeps it).
 counter_vertices, faces, frames, corner_normals, grid, keys, starts, items
     A mesh and its face grid (:mod:`meshwear.kernels.nearest`).
+part : tuple
+    Its wear (:data:`meshwear.kernels.counter_wear.PART_FIELDS`; law code -1:
+    it does not wear); wear moves its faces.
 """
 
 from numba import njit
@@ -33,7 +36,7 @@ from .nearest import nearest_planes_parallel, nearest_planes_serial
 MESH, CYLINDER, SPHERE = 0, 1, 2
 KINDS = {"mesh": MESH, "cylinder": CYLINDER, "sphere": SPHERE}
 SURFACE_FIELDS = ("kind", "geometry", "motion", "terms", "frozen", "counter_vertices", "faces",
-                  "frames", "corner_normals", "grid", "keys", "starts", "items")
+                  "frames", "corner_normals", "grid", "keys", "starts", "items", "part")
 
 #: active vertices from which the threaded kernels pay for their threads
 PARALLEL_THRESHOLD = 2048
@@ -47,12 +50,13 @@ def fill_planes(surface, t, body_vertices, pose, active, out, distance, hint, bu
     (n,) int64 (the face under it). ``buffer`` (2, 3), ``rotation`` (3, 3) and
     ``frame`` (4, 3) are scratch; they hold the surface's frame afterwards."""
     (kind, geometry, motion, terms, frozen, counter_vertices, faces, frames, corner_normals,
-     grid, keys, starts, items) = surface
+     grid, keys, starts, items, part) = surface
     surface_frame(motion, terms, t, frozen, buffer, rotation, frame)
     threads = active.shape[0] >= PARALLEL_THRESHOLD
     if kind == MESH:
-        # the frame turns only for a turning surface that is not frozen
-        fixed = frozen or motion[15] == 0.0
+        # its faces stay put in its frame: the frame turns only for a
+        # turning surface that is not frozen, and wear moves faces
+        fixed = (frozen or motion[15] == 0.0) and part[0][0] < 0.0
         if threads:
             nearest_planes_parallel(body_vertices, pose, active, rotation, frame,
                                     counter_vertices, faces, frames, corner_normals, grid, keys,

@@ -61,6 +61,11 @@ def code_of(name):
     return LAWS[name].code
 
 
+def name_of(code):
+    """The name of the law of kernel code ``code``."""
+    return next(name for name, law in LAWS.items() if law.code == code)
+
+
 def _dispatch(increments):
     """``wear_increment(code, k, energy, load, slip, area)``: the increment of
     law ``code``, built as a chain of tests (numba compiles each link with the

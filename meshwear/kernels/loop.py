@@ -5,9 +5,11 @@
 step ``k`` up to ``stop``, and hands back to Python whatever it does not do
 itself: an active-set refresh (before the step that needs it, having changed
 nothing of that step, or, in the quasi-static mode, after the settling move
-of a step, for Python to finish it), and a load nothing carries. Bodies do
-not act on one another (only on counter-surfaces), so each runs on its own
-between two output times.
+of a step, for Python to finish it), a load nothing carries and a counter
+vertex worn too deep. Bodies do not act on one another (only on
+counter-surfaces), so each runs on its own between two output times, unless
+a counter-surface they share wears (then :mod:`meshwear.stepper` steps them
+in turn, one step each).
 
 Arguments are grouped in tuples (:mod:`meshwear.stepper` packs them):
 
@@ -30,6 +32,8 @@ surfaces
     A typed list of surface tuples (:mod:`meshwear.kernels.counter`).
 bounds, terms
     The active-set bounds of every slot (:mod:`meshwear.kernels.frames`).
+report
+    (2,) int64: where a counter vertex worn too deep is reported (surface, vertex).
 """
 
 import numpy as np
@@ -38,11 +42,12 @@ from numba import njit
 from .balance import balance_offset
 from .contact import PARALLEL_THRESHOLD, contact_parallel, contact_serial
 from .counter import fill_planes
-from .frames import moved_since_refresh, plane_rows, step_motion
+from .counter_wear import wear_counter
+from .frames import moved_since_refresh, plane_rows, step_motion, surface_frame
 from .rigid import AXIS, BALANCED, CARRIED, advance_motion, place_motion
 
 #: what :func:`advance_body` returns besides the step it reached
-DONE, REFRESH, FINISH, NO_BALANCE = 0, 1, 2, 3
+DONE, REFRESH, FINISH, NO_BALANCE, TOO_DEEP = 0, 1, 2, 3, 4
 
 
 @njit(cache=True)
@@ -85,6 +90,29 @@ def _touch(body, plane_array):
 
 
 @njit(cache=True)
+def _wear_parts(body, surfaces, law, n_planes, t, buffer, rotation, frame, report):
+    """The worn counter-surfaces' wear by the step just taken at ``t``
+    (:func:`meshwear.kernels.counter_wear.wear_counter`); False, with the
+    surface and vertex in ``report``, if a counter vertex sank too deep."""
+    vertices, pose, area = body[0], body[1], body[2]
+    contact_state, normal_force = body[5], body[7]
+    vertex_planes, hint, active = body[12], body[13], body[14]
+    for m in range(len(surfaces)):
+        surface = surfaces[m]
+        part = surface[13]
+        if part[0][0] < 0.0:
+            continue
+        surface_frame(surface[2], surface[3], t, surface[4], buffer, rotation, frame)
+        worst = wear_counter(vertices, pose, active, area, law, contact_state[n_planes + m],
+                             normal_force[n_planes + m], vertex_planes[m], hint[m], rotation,
+                             frame, part)
+        if worst >= 0:
+            report[0], report[1] = m, worst
+            return False
+    return True
+
+
+@njit(cache=True)
 def _needs_refresh(body, bounds, terms, t, dt, buffer, cull_enabled):
     """``meshwear.surfaces.needs_refresh``: the active set must be rebuilt before a step at ``t``."""
     pose, wear_depth, active, active_wear, cull, radius = (body[1], body[9], body[14], body[15],
@@ -100,17 +128,24 @@ def _needs_refresh(body, bounds, terms, t, dt, buffer, cull_enabled):
 
 @njit(cache=True)
 def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, surfaces, bounds,
-                 terms):
+                 terms, report):
     """Step one body from step ``k`` up to ``stop``. Returns ``(step, what)``:
     the step reached and :data:`DONE` (``step == stop``), :data:`REFRESH`
     (step ``step`` needs an active-set refresh first; nothing of it is done),
     :data:`FINISH` (quasi-static: step ``step`` is placed, its planes queried
     and the body settled, but its bound is reached: refresh, query and touch
-    are left) or :data:`NO_BALANCE` (no contact carries the load at step ``step``)."""
+    are left), :data:`NO_BALANCE` (no contact carries the load at step
+    ``step``) or :data:`TOO_DEEP` (step ``step`` wore a counter vertex deeper
+    than its mesh follows: surface and vertex in ``report``; the step's
+    contact is done, its motion is not)."""
     vertices, pose, area, law = body[0], body[1], body[2], body[3]
     vertex_planes, active, cull, radius = body[12], body[14], body[16], body[19]
     kind, params, path_terms, buffer, scratch = motion
     plane_array = planes[0]
+    n_planes = plane_array.shape[0]
+    worn = False
+    for m in range(len(surfaces)):
+        worn = worn or surfaces[m][13][0][0] >= 0.0
     rotation, frame = np.zeros((3, 3)), np.zeros((4, 3))
     placed = np.zeros(13)
     no_scale = np.zeros(0)
@@ -124,6 +159,9 @@ def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, 
                 return k, REFRESH
             _fill(body, planes, surfaces, t, buffer, rotation, frame)
             _touch(body, plane_array)
+            if worn and not _wear_parts(body, surfaces, law, n_planes, t, buffer,
+                                        rotation, frame, report):
+                return k, TOO_DEEP
             advance_motion(kind, params, path_terms, buffer, pose, body[11], t, dt)
             k += 1
             continue
@@ -159,5 +197,8 @@ def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, 
                                                     body[9], active, body[15], buffer) >= cull[0]:
                 return k, FINISH
         _touch(body, plane_array)
+        if worn and not _wear_parts(body, surfaces, law, n_planes, t, buffer, rotation,
+                                    frame, report):
+            return k, TOO_DEEP
         k += 1
     return k, DONE

@@ -60,3 +60,100 @@ def body_quantities(body, s, model):
         "max_wear_depth": float(s.wear_depth.max()),
         "total_friction_work": float(s.friction_work.sum()),
     }
+
+
+def _matrix_quaternion(R):
+    """Unit quaternion (w, x, y, z), w >= 0, of a rotation matrix (Shepperd's method)."""
+    trace = R[0, 0] + R[1, 1] + R[2, 2]
+    k = int(np.argmax([trace, R[0, 0], R[1, 1], R[2, 2]]))
+    if k == 0:
+        w = 0.5 * np.sqrt(1.0 + trace)
+        q = [w, (R[2, 1] - R[1, 2]) / (4 * w), (R[0, 2] - R[2, 0]) / (4 * w),
+             (R[1, 0] - R[0, 1]) / (4 * w)]
+    else:
+        i, j, m = k - 1, k % 3, (k + 1) % 3
+        r = 0.5 * np.sqrt(1.0 + R[i, i] - R[j, j] - R[m, m])
+        q = [0.0, 0.0, 0.0, 0.0]
+        q[0] = (R[m, j] - R[j, m]) / (4 * r)
+        q[1 + i] = r
+        q[1 + j] = (R[j, i] + R[i, j]) / (4 * r)
+        q[1 + m] = (R[m, i] + R[i, m]) / (4 * r)
+    q = np.array(q)
+    return q if q[0] >= 0.0 else -q
+
+
+def part_quantities(model, state, m):
+    """Per-vertex fields and totals of the worn counter-surface of slot
+    ``m`` of the per-vertex surfaces, as :func:`body_quantities` gives a
+    body's: each pair's normal force and friction force (the reaction on the
+    counter-part) shared among the vertices of the face under it by the
+    barycentric weights of its contact point; pressure is their normal force
+    over their tributary area; contact state the highest of the pairs there.
+    Totals: the force and torque (about the surface frame's origin) on it, and
+    the frame's pose and velocity."""
+    surface = model.surfaces.per_vertex[m]
+    part = state.parts[m]
+    n = len(part.depth)
+    rotation, frame = surface.frame(state.time)
+    slot = model.planes.shape[0] + m
+    normal_force, friction_force = np.zeros(n), np.zeros((n, 3))
+    contact_state = np.zeros(n, np.int32)
+    force, torque = np.zeros(3), np.zeros(3)
+    for s in state.bodies:
+        pairs = s.active[(s.normal_force[slot, s.active] > 0.0) & (s.hint[m, s.active] >= 0)]
+        if not len(pairs):
+            continue
+        planes = s.vertex_planes[m, pairs]
+        R = np.array(rotation_entries(s.pose[3:7])).reshape(3, 3)
+        x = s.pose[0:3] + s.vertices[pairs] @ R.T
+        delta = np.einsum("ij,ij->i", x - planes[:, 0], planes[:, 1])
+        foot = x - delta[:, None] * planes[:, 1]
+        load = s.normal_force[slot, pairs]
+        friction = -s.tangential[slot, pairs, FORCE]
+        reaction = -load[:, None] * planes[:, 1] + friction
+        force += reaction.sum(axis=0)
+        torque += np.cross(foot - frame[0], reaction).sum(axis=0)
+        weights, corners = _face_weights(part.vertices, surface.faces,
+                                         (foot - frame[0]) @ rotation, s.hint[m, pairs])
+        for c in range(3):
+            np.add.at(normal_force, corners[:, c], weights[:, c] * load)
+            np.add.at(friction_force, corners[:, c], weights[:, c, None] * friction)
+            np.maximum.at(contact_state, corners[:, c],
+                          np.where(weights[:, c] > 0.0, s.contact_state[slot, pairs], 0))
+    counts = np.bincount(contact_state, minlength=3)
+    return {
+        "points": surface.world_vertices(part.vertices, state.time),
+        "wear_depth": part.depth,
+        "normal_force": normal_force,
+        "friction_force": friction_force,
+        "pressure": normal_force / surface.tributary,
+        "contact_state": contact_state,
+        "friction_work": part.work,
+        "origin": frame[0].copy(),
+        "orientation": _matrix_quaternion(rotation),
+        "velocity": frame[1].copy(),
+        "angular_velocity": frame[2].copy(),
+        "wrench": np.concatenate([force, torque]),
+        "wear_volume": float(part.volume.sum()),
+        "max_wear_depth": float(part.depth.max()),
+        "total_friction_work": float(part.work.sum()),
+        "contact_points": int(counts[1] + counts[2]),
+        "stick_points": int(counts[1]),
+        "slip_points": int(counts[2]),
+    }
+
+
+def _face_weights(vertices, faces, points, face):
+    """Barycentric weights (k, 3) of ``points`` (k, 3) projected on their
+    faces ``face`` (k,), clipped to the triangle, and the faces' corners."""
+    corners = faces[face]
+    a, b, c = (vertices[corners[:, j]] for j in range(3))
+    v0, v1, v2 = b - a, c - a, points - a
+    d00, d01, d11 = (np.einsum("ij,ij->i", p, q) for p, q in ((v0, v0), (v0, v1), (v1, v1)))
+    d20, d21 = np.einsum("ij,ij->i", v2, v0), np.einsum("ij,ij->i", v2, v1)
+    denom = d00 * d11 - d01 * d01
+    v = (d11 * d20 - d01 * d21) / denom
+    w = (d00 * d21 - d01 * d20) / denom
+    weights = np.clip(np.stack([1.0 - v - w, v, w], axis=1), 0.0, None)
+    weights /= weights.sum(axis=1, keepdims=True)
+    return weights, corners

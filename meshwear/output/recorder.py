@@ -7,7 +7,7 @@ Physics never writes files; :func:`meshwear.simulate.run` calls
 from pathlib import Path
 
 from ..wear import error_estimate
-from .fields import body_quantities, body_totals
+from .fields import body_quantities, body_totals, part_quantities
 from .tables import HISTORY_COLUMNS, HistoryWriter, write_json_atomic
 from .vtk import PVDSeries
 
@@ -37,7 +37,12 @@ class RunRecorder:
         self.history = HistoryWriter(self.out_dir / "history.csv", EXTRA_COLUMNS, resume_until)
         # counter-surfaces: one frame if they stay put, else one per frame
         self.moving = {}
+        # worn counter-surfaces: a series with a body's fields, history rows
+        self.parts = {m: PVDSeries(self.out_dir, surface.name, surface.faces, resume_until)
+                      for m, surface in enumerate(model.surfaces.per_vertex) if surface.worn}
         for surface in model.surfaces.slots:
+            if surface.worn:
+                continue
             vertices, faces = surface.drawing(model.extent)
             if surface.static:
                 still = PVDSeries(self.out_dir, surface.name, faces)
@@ -61,6 +66,19 @@ class RunRecorder:
                        contact_points=q["contact_points"], stick_points=q["stick_points"],
                        slip_points=q["slip_points"], resolved=int(state.resolved))
             self.history.write(row)
+        for m in self.parts:
+            q = part_quantities(model, state, m)
+            row = dict(zip(("x", "y", "z"), q["origin"]))
+            row.update(zip(("qw", "qx", "qy", "qz"), q["orientation"]))
+            row.update(zip(("vx", "vy", "vz"), q["velocity"]))
+            row.update(zip(("wx", "wy", "wz"), q["angular_velocity"]))
+            row.update(zip(("fx", "fy", "fz", "tx", "ty", "tz"), q["wrench"]))
+            row.update(time=state.time, body=model.surfaces.per_vertex[m].name,
+                       friction_work=q["total_friction_work"], wear_volume=q["wear_volume"],
+                       max_wear_depth=q["max_wear_depth"], contact_points=q["contact_points"],
+                       stick_points=q["stick_points"], slip_points=q["slip_points"],
+                       resolved=int(state.resolved))
+            self.history.write(row)
 
     def on_frame(self, model, state):
         for body, s in zip(model.bodies, state.bodies):
@@ -69,10 +87,14 @@ class RunRecorder:
                                                {"resolved": int(state.resolved)})
         for surface, vertices, series in self.moving.values():
             series.write_frame(state.time, surface.world_vertices(vertices, state.time), {})
+        for m, series in self.parts.items():
+            q = part_quantities(model, state, m)
+            series.write_frame(state.time, q["points"], {k: q[k] for k in FIELDS},
+                               {"resolved": int(state.resolved)})
 
     def close(self, summary):
         self.history.close()
-        for series in self.series.values():
+        for series in list(self.series.values()) + list(self.parts.values()):
             series.close()
         for _, _, series in self.moving.values():
             series.close()
@@ -116,6 +138,23 @@ def summary(model, state, wall_time, status="ok", message=None):
             "contact_points": q["contact_points"],
             "vertices": int(len(s.wear_depth)),
             "active_vertices": int(len(s.active)),
+        }
+    # worn counter-surfaces, in the shape of a body's entry
+    for m, surface in enumerate(model.surfaces.per_vertex):
+        if not surface.worn:
+            continue
+        q = part_quantities(model, state, m)
+        out.setdefault("surfaces", {})[surface.name] = {
+            "wear_volume": q["wear_volume"],
+            "max_wear_depth": q["max_wear_depth"],
+            "friction_work": q["total_friction_work"],
+            "position": q["origin"].tolist(),
+            "orientation": q["orientation"].tolist(),
+            "velocity": q["velocity"].tolist(),
+            "angular_velocity": q["angular_velocity"].tolist(),
+            "contact_force": q["wrench"][0:3].tolist(),
+            "contact_points": q["contact_points"],
+            "vertices": int(len(q["wear_depth"])),
         }
     return out
 

@@ -218,15 +218,18 @@ def refresh(model, body, s, t):
         near |= (x - p[0]) @ p[1] < margin
     scratch = s.cull_scratch
     for surface in surfaces.per_vertex:
-        surface.ensure_reach(margin)
-        candidates = surface.candidates(surfaces, body, s.pose, x, t, margin)
+        # a worn surface moving within itself (turning, sliding) brings its
+        # less worn parts under a vertex: nearer by at most its deepest wear
+        reach = margin + (float(surface.part.depth.max()) if surface.worn else 0.0)
+        surface.ensure_reach(reach)
+        candidates = surface.candidates(surfaces, body, s.pose, x, t, reach)
         if not len(candidates):
             continue
         scratch.planes[candidates] = 0.0
         scratch.hint[candidates] = -1
         surface.fill(s.vertices, s.pose, candidates, scratch.planes, scratch.distance,
                      scratch.hint, t)
-        near[candidates[scratch.distance[candidates] < margin]] = True
+        near[candidates[scratch.distance[candidates] < reach]] = True
     active = np.flatnonzero(near)
     left = np.setdiff1d(s.active, active, assume_unique=True)
     if len(left):

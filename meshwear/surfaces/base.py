@@ -42,6 +42,7 @@ import numpy as np
 from ..kernels.frames import (BOUNDS_SIZE, CONSTANT, LEVER, NORMAL, PROJECTION, RATE, UNIFORM,
                               surface_frame)
 from ..kernels.contact import rotation_entries
+from ..kernels.counter_wear import NO_PART
 from ..motion import Path
 
 
@@ -127,6 +128,8 @@ class CounterSurface:
 
     uniform = False
     kind = None
+    #: it wears (a mesh with ``wear = true``: :meth:`MeshSurface.make_worn`)
+    worn = False
 
     def __init__(self, name, motion):
         self.name = name
@@ -143,8 +146,9 @@ class CounterSurface:
 
     @property
     def frozen(self):
-        """Queries leave its turn out (it moves, but not its shape)."""
-        return self.invariant and self.motion.rate != 0.0
+        """Queries leave its turn out (it moves, but not its shape; a worn
+        surface's wear turns with it, so its queries do too)."""
+        return self.invariant and self.motion.rate != 0.0 and not self.worn
 
     @property
     def period(self):
@@ -182,14 +186,20 @@ class CounterSurface:
         text = " and ".join(parts)
         if self.invariant and m.rate:
             exact = (f"within {self.deviation:.3g} m" if self.deviation > 0.0 else "exactly")
-            text += (f" about its own axis (a surface of revolution {exact}): "
-                     "static in shape")
+            text += f" about its own axis (a surface of revolution {exact}): "
+            text += ("its active set stays put, its face lookups follow its wear round"
+                     if self.worn else "static in shape")
         return text
 
     # ---------------------------------------------------------- planes
     def plane_row(self, t, out):
         """Uniform planes: fill the (4, 3) row of the kernel's ``planes`` at ``t``."""
         raise NotImplementedError
+
+    def part_tuple(self):
+        """Its wear as :func:`meshwear.kernels.counter_wear.wear_counter` takes
+        it: none (law code -1) unless a worn mesh overrides this."""
+        return NO_PART
 
     def geometry(self):
         """Per-vertex kinds: ``geometry`` (g,) and the mesh arrays of a surface
@@ -207,7 +217,8 @@ class CounterSurface:
             self._compiled = (np.int64(self.kind), np.ascontiguousarray(g["geometry"], float),
                               self.motion.array, np.ascontiguousarray(self.motion.terms),
                               bool(self.frozen), g["counter_vertices"], g["faces"], g["frames"],
-                              g["corner_normals"], g["grid"], g["keys"], g["starts"], g["items"])
+                              g["corner_normals"], g["grid"], g["keys"], g["starts"], g["items"],
+                              self.part_tuple())
         return self._compiled
 
     def fill(self, body_vertices, pose, active, out, distance, hint, t):

@@ -12,6 +12,7 @@ import numpy as np
 
 from .. import geometry
 from ..kernels.counter import MESH
+from ..kernels.laws import name_of as code_name
 from ..kernels.nearest import (build_grid, corner_normals, face_frames, nearest_planes_parallel,
                                nearest_planes_serial)
 from .base import CounterSurface, SurfaceMotion, axis_rotation, quaternion_matrix
@@ -58,6 +59,8 @@ class MeshSurface(CounterSurface):
         self.lever = float(np.linalg.norm(world - np.outer(world @ m.axis, m.axis), axis=1).max())
         self.reach = 0.0
         self.grid = None
+        #: the :class:`meshwear.model.PartState` a worn one queries and draws
+        self.part = None
         self.bvh_geometry = bvh(self.vertices, self.faces)
         self.bvh = fcl.CollisionObject(self.bvh_geometry, fcl.Transform())
 
@@ -81,7 +84,9 @@ class MeshSurface(CounterSurface):
         """Decide whether its turn leaves its shape unchanged, against the
         smallest active-set ``margin`` (m): its deviation from a surface of
         revolution about the turn's axis at most :data:`INVARIANT_FRACTION`
-        of it."""
+        of it. A worn one keeps the active set of one (a body's vertex is
+        never nearer its worn surface than its unworn one, and the refresh
+        widens by the wear), but its queries turn with it: its wear does."""
         if self.motion.rate == 0.0:
             return
         limit = INVARIANT_FRACTION * margin
@@ -119,6 +124,45 @@ class MeshSurface(CounterSurface):
             if not worst <= limit:
                 return np.inf
         return worst
+
+    # ------------------------------------------------------------ wear
+    def make_worn(self, law_code, coefficient):
+        """Let it wear by law ``law_code`` (:mod:`meshwear.kernels.laws`) with
+        ``coefficient``: it keeps its unworn vertices, their outward normals
+        (wear moves a vertex against its normal), tributary areas, the
+        shortest edge at each vertex and the faces at each vertex."""
+        self.law = np.array([float(law_code), float(coefficient)])
+        self.reference_vertices = self.vertices.copy()
+        self.vertex_normals = geometry.vertex_normals(self.vertices, self.faces)
+        self.tributary = geometry.tributary_areas(self.vertices, self.faces)
+        edges = np.concatenate([self.faces[:, [0, 1]], self.faces[:, [1, 2]],
+                                self.faces[:, [2, 0]]])
+        lengths = np.linalg.norm(self.vertices[edges[:, 0]] - self.vertices[edges[:, 1]], axis=1)
+        self.spacing = np.full(len(self.vertices), np.inf)
+        np.minimum.at(self.spacing, edges.ravel(), np.repeat(lengths, 2))
+        corners = self.faces.ravel()
+        order = np.argsort(corners, kind="stable")
+        self.vertex_face_items = np.ascontiguousarray(order // 3, dtype=np.int64)
+        self.vertex_face_starts = np.concatenate(
+            [[0], np.cumsum(np.bincount(corners, minlength=len(self.vertices)))]).astype(np.int64)
+        self.worn = True
+        self.invariant = False
+        self._compiled = None
+
+    def attach(self, part):
+        """Query and draw the worn geometry of ``part`` (a
+        :class:`meshwear.model.PartState`): its vertices and face frames."""
+        self.vertices, self.frames, self.part = part.vertices, part.frames, part
+        self._compiled = None
+
+    def part_tuple(self):
+        """The ``part`` tuple of :func:`meshwear.kernels.counter_wear.wear_counter`."""
+        if not self.worn or self.part is None:     # (not attached to a state yet)
+            return super().part_tuple()
+        part = self.part
+        return (self.law, self.faces, self.reference_vertices, self.vertex_normals,
+                self.tributary, self.spacing, self.vertex_face_starts, self.vertex_face_items,
+                part.vertices, part.frames, part.depth, part.volume, part.work, part.added)
 
     # ------------------------------------------------------------ the interface
     def ensure_reach(self, reach):
@@ -173,4 +217,6 @@ class MeshSurface(CounterSurface):
         text = super().describe()
         if self.motion.rate and not self.invariant:
             text += " (not a surface of revolution about that axis: its turn changes its shape)"
+        if self.worn:
+            text += f"; wears ({code_name(int(self.law[0]))}, coefficient {self.law[1]:g})"
         return text

@@ -1,0 +1,174 @@
+"""Wear of a mesh counter-part: each contact's wear on the face under it.
+
+The contact points stay the worn body's vertices (docs/model.md, "Worn
+counter-surfaces"). After the contact kernel, each pair of the step that
+touches a worn counter mesh wears it by its law's volume on the counter's
+own coefficient (:mod:`meshwear.kernels.laws`), from the same dissipated
+energy, load and slip distance as the body's wear. The volume goes to the
+three vertices of the face under the contact by the barycentric weights of
+the contact point, becomes depth over each vertex's tributary area, and the
+vertex moves by its depth along its inward normal; the faces around a moved
+vertex get their frames again. So the counter's worn volume is its
+coefficient times the pairs' load times slip (or energy), exactly.
+
+Arrays (float64 unless said otherwise) besides those of
+:mod:`meshwear.kernels.contact`:
+
+planes : (n, 3, 3)
+    The body's ``vertex_planes`` row of this surface (point, normal, velocity).
+hint : (n,) int64
+    The face under each vertex (``-1``: none).
+rotation, frame : (3, 3), (4, 3)
+    The surface's frame at the step (:func:`meshwear.kernels.frames.surface_frame`).
+part : tuple
+    The counter-part (:data:`PART_FIELDS`): law code and coefficient (2,),
+    faces (F, 3) int64, reference vertices, outward unit vertex normals
+    (V, 3), tributary areas (V,), local spacing (V,: the shortest edge at the
+    vertex), the faces at each vertex (``starts`` (V + 1,) and ``items``
+    int64), then what wear changes: vertices (V, 3), face frames (F, 4, 4),
+    wear depth, worn volume, friction work (V,) and scratch (V,).
+"""
+
+import numpy as np
+from numba import njit
+
+from .contact import NO_CONTACT, SLIP, rotation_entries
+from .laws import wear_increment
+from .nearest import closest_on_triangle
+
+PART_FIELDS = ("law", "faces", "reference", "normals", "tributary", "spacing", "starts", "items",
+               "vertices", "frames", "depth", "volume", "work", "added")
+
+#: the part tuple of a surface that does not wear
+NO_PART = (np.array([-1.0, 0.0]), np.zeros((0, 3), np.int64), np.zeros((0, 3)), np.zeros((0, 3)),
+           np.zeros(0), np.zeros(0), np.zeros(1, np.int64), np.zeros(0, np.int64),
+           np.zeros((0, 3)), np.zeros((0, 4, 4)), np.zeros(0), np.zeros(0), np.zeros(0),
+           np.zeros(0))
+
+#: a counter vertex may sink by at most this fraction of its shortest edge in
+#: one step; deeper, its faces could fold over
+SPACING_FRACTION = 0.5
+
+
+@njit(cache=True, inline="always")
+def _face_frame(vertices, faces, f, frames):
+    """Frame of face ``f`` (:func:`meshwear.kernels.nearest.face_frames`), in place."""
+    a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+    p = np.empty((3, 3))
+    for j in range(3):
+        p[0, j], p[1, j], p[2, j] = vertices[a, j], vertices[b, j], vertices[c, j]
+    ux, uy, uz = p[1, 0] - p[0, 0], p[1, 1] - p[0, 1], p[1, 2] - p[0, 2]
+    vx, vy, vz = p[2, 0] - p[0, 0], p[2, 1] - p[0, 1], p[2, 2] - p[0, 2]
+    nx, ny, nz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+    length = np.sqrt(nx * nx + ny * ny + nz * nz)
+    nx, ny, nz = nx / length, ny / length, nz / length
+    frames[f, 0, 0], frames[f, 0, 1], frames[f, 0, 2] = nx, ny, nz
+    frames[f, 0, 3] = nx * p[0, 0] + ny * p[0, 1] + nz * p[0, 2]
+    for k in range(3):
+        q = (k + 1) % 3
+        ex, ey, ez = p[q, 0] - p[k, 0], p[q, 1] - p[k, 1], p[q, 2] - p[k, 2]
+        mx, my, mz = ey * nz - ez * ny, ez * nx - ex * nz, ex * ny - ey * nx
+        length = np.sqrt(mx * mx + my * my + mz * mz)
+        mx, my, mz = mx / length, my / length, mz / length
+        frames[f, k + 1, 0], frames[f, k + 1, 1], frames[f, k + 1, 2] = mx, my, mz
+        frames[f, k + 1, 3] = mx * p[k, 0] + my * p[k, 1] + mz * p[k, 2]
+
+
+@njit(cache=True)
+def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_force, planes,
+                 hint, rotation, frame, part):
+    """Wear the counter-part ``part`` by every pair of the step just taken
+    (``contact_state``, ``normal_force``: this surface's rows). Returns -1,
+    or the first counter vertex that sank deeper than
+    :data:`SPACING_FRACTION` of its spacing in this step (the step is done
+    all the same: the caller stops the run)."""
+    (counter_law, faces, reference, normals, tributary, spacing, starts, items, vertices, frames,
+     depth, volume, work, added) = part
+    code, k_counter = int(counter_law[0]), counter_law[1]
+    f, dt = law[0], law[4]
+    dt0, dt1 = law[11], law[12]
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
+    cx, cy, cz = pose[0], pose[1], pose[2]
+    vx, vy, vz = pose[7], pose[8], pose[9]
+    wx, wy, wz = pose[10], pose[11], pose[12]
+    touched = np.empty(3 * active.shape[0], np.int64)
+    count = 0
+    for slot in range(active.shape[0]):
+        i = active[slot]
+        state = contact_state[i]
+        load = normal_force[i]
+        face = hint[i]
+        if state == NO_CONTACT or load <= 0.0 or face < 0:
+            continue
+        nx, ny, nz = planes[i, 1, 0], planes[i, 1, 1], planes[i, 1, 2]
+        # the vertex, its foot on the plane and the contact area (as the
+        # contact kernel has them)
+        bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
+        rx = r00 * bx + r01 * by + r02 * bz
+        ry = r10 * bx + r11 * by + r12 * bz
+        rz = r20 * bx + r21 * by + r22 * bz
+        px, py, pz = cx + rx, cy + ry, cz + rz
+        delta = ((px - planes[i, 0, 0]) * nx + (py - planes[i, 0, 1]) * ny
+                 + (pz - planes[i, 0, 2]) * nz)
+        ax, ay, az = px - delta * nx, py - delta * ny, pz - delta * nz
+        mx = r00 * nx + r10 * ny + r20 * nz
+        my = r01 * nx + r11 * ny + r21 * nz
+        mz = r02 * nx + r12 * ny + r22 * nz
+        a = -(mx * area[i, 0] + my * area[i, 1] + mz * area[i, 2])
+        if a <= 0.0:
+            continue
+        # slip velocity: the point's velocity relative to the surface there
+        gx = vx + wy * rz - wz * ry - planes[i, 2, 0]
+        gy = vy + wz * rx - wx * rz - planes[i, 2, 1]
+        gz = vz + wx * ry - wy * rx - planes[i, 2, 2]
+        rate = gx * nx + gy * ny + gz * nz
+        sx, sy, sz = gx - rate * nx, gy - rate * ny, gz - rate * nz
+        speed2 = sx * sx + sy * sy + sz * sz
+        # the pair's dissipated energy and slip distance in the step
+        if state == SLIP:
+            speed = np.sqrt(speed2)
+            energy = f * load * speed * dt
+            slip = speed * dt
+        else:
+            energy = (dt0 + dt1 * a) * speed2 * dt
+            slip = 0.0
+        dv = wear_increment(code, k_counter, energy, load, slip, a)[1]
+        if dv <= 0.0 and energy <= 0.0:
+            continue
+        # the contact point in the counter's frame, its weights on the face
+        ex, ey, ez = ax - frame[0, 0], ay - frame[0, 1], az - frame[0, 2]
+        qx = rotation[0, 0] * ex + rotation[1, 0] * ey + rotation[2, 0] * ez
+        qy = rotation[0, 1] * ex + rotation[1, 1] * ey + rotation[2, 1] * ez
+        qz = rotation[0, 2] * ex + rotation[1, 2] * ey + rotation[2, 2] * ez
+        j0, j1, j2 = faces[face, 0], faces[face, 1], faces[face, 2]
+        weights = closest_on_triangle(
+            qx, qy, qz, vertices[j0, 0], vertices[j0, 1], vertices[j0, 2],
+            vertices[j1, 0], vertices[j1, 1], vertices[j1, 2],
+            vertices[j2, 0], vertices[j2, 1], vertices[j2, 2])[3:6]
+        for corner in range(3):
+            j = faces[face, corner]
+            share = weights[corner]
+            if share <= 0.0:
+                continue
+            work[j] += share * energy
+            if dv > 0.0:
+                volume[j] += share * dv
+                sink = share * dv / tributary[j]
+                depth[j] += sink
+                if added[j] == 0.0:
+                    touched[count] = j
+                    count += 1
+                added[j] += sink
+    worst = -1
+    for c in range(count):
+        j = touched[c]
+        if worst < 0 and added[j] > SPACING_FRACTION * spacing[j]:
+            worst = j
+        added[j] = 0.0
+        for col in range(3):
+            vertices[j, col] = reference[j, col] - depth[j] * normals[j, col]
+    for c in range(count):
+        j = touched[c]
+        for e in range(starts[j], starts[j + 1]):
+            _face_frame(vertices, faces, items[e], frames)
+    return worst

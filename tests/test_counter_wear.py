@@ -1,0 +1,229 @@
+"""Worn counter-surfaces (docs/model.md, "Worn counter-surfaces"): the wear
+of a mesh counter-part from the same pairs as the body's, its kernel against
+the numpy twin, conservation, the chord law of a pin's track on a turning
+disc, outputs, checkpoints and refusals."""
+
+import copy
+import json
+
+import numpy as np
+import pytest
+import pyvista
+
+import cases
+import reference
+from meshwear import checkpoint
+from meshwear.cli import main
+from meshwear.kernels.counter_wear import wear_counter
+from meshwear.model import build_model, initial_state
+from meshwear.scene import SceneError, load_scene
+from meshwear.simulate import NumericalError, run
+
+#: a flat pin (radius a = 1 mm) held R = 5 mm off the axis of a disc turning
+#: at 10 rad/s, pressed by P = 10 N (quasi-static, Archard); both wear, the
+#: disc twice as fast. Two turns.
+PIN_ON_WORN_DISC = """format = 1
+[run]
+mode = "quasi-static"
+duration = {duration}
+dt = 2e-3
+frames = 3
+history = 5
+[contact]
+stiffness_per_area = 1e13
+friction = 0.4
+[wear]
+law = "archard"
+coefficient = 1e-13
+[[body]]
+name = "pin"
+shape = {{ type = "cylinder", radius = 0.001, height = 0.003, sections = 24 }}
+resolution = 1.5e-4
+position = [0.005, 0.0, 0.0015]
+force = [0.0, 0.0, -10.0]
+motion = "guided"
+density = 7850.0
+[body.path]
+free_axis = [0.0, 0.0, 1.0]
+[[surface]]
+name = "disc"
+type = "mesh"
+shape = {{ type = "cylinder", radius = 0.008, height = 0.002, sections = 64 }}
+resolution = 3e-4
+position = [0.0, 0.0, -0.001]
+rotation = {{ axis = [0.0, 0.0, 1.0], rate = 10.0, center = [0.0, 0.0, 0.0] }}
+wear = true
+coefficient = {coefficient}
+"""
+P, A, R, OMEGA, K_PIN, K_DISC = 10.0, 1e-3, 5e-3, 10.0, 1e-13, 2e-13
+TWO_TURNS = 4.0 * np.pi / OMEGA
+
+
+def _scene(tmp_path, duration=TWO_TURNS, coefficient=K_DISC, extra=""):
+    path = tmp_path / "pin_on_worn_disc.toml"
+    path.write_text(PIN_ON_WORN_DISC.format(duration=duration, coefficient=coefficient) + extra)
+    return path
+
+
+@pytest.fixture(scope="module")
+def two_turns(tmp_path_factory):
+    model = build_model(load_scene(_scene(tmp_path_factory.mktemp("disc"))))
+    return model, run(model, initial_state(model))
+
+
+def test_kernel_matches_its_numpy_twin(tmp_path):
+    model = build_model(load_scene(_scene(tmp_path, duration=0.1)))
+    state = run(model, initial_state(model))
+    disc, part, s, body = model.surfaces.per_vertex[0], state.parts[0], state.bodies[0], \
+        model.bodies[0]
+    assert (s.normal_force[0, s.active] > 0.0).sum() > 100, "the case must have pairs"
+    rotation, frame = disc.frame(state.time)
+    twin = copy.deepcopy(part)
+    args = (s.vertices, s.pose, s.active, body.area_vectors, model.law, s.contact_state[0],
+            s.normal_force[0], s.vertex_planes[0], s.hint[0], rotation, frame)
+    depth0 = part.depth.copy()
+    assert wear_counter(*args, disc.part_tuple()) == -1
+    twin_tuple = (disc.law, disc.faces, disc.reference_vertices, disc.vertex_normals,
+                  disc.tributary, disc.spacing, None, None, twin.vertices, twin.frames,
+                  twin.depth, twin.volume, twin.work, twin.added)
+    assert len(reference.wear_counter(*args, twin_tuple)) == 0
+    assert (part.depth > depth0).sum() > 10
+    for name in ("depth", "volume", "work", "vertices"):
+        np.testing.assert_allclose(getattr(part, name), getattr(twin, name), rtol=1e-12,
+                                   atol=1e-12 * np.abs(getattr(twin, name)).max())
+    touched = np.unique(disc.faces[np.isin(disc.faces, np.flatnonzero(part.depth > depth0))
+                                   .any(axis=1)].ravel())
+    faces = np.flatnonzero(np.isin(disc.faces, touched).any(axis=1))
+    np.testing.assert_allclose(part.frames[faces], twin.frames[faces], rtol=0, atol=1e-12)
+
+
+def test_both_parts_wear_their_coefficient_times_load_times_sliding(two_turns, measured):
+    """Each part's worn volume = its k P s (Archard); s is the mean sliding
+    distance of the pin's face, omega t (R + a²/8R) for a uniform pressure."""
+    model, state = two_turns
+    s = OMEGA * state.time * (R + A * A / (8.0 * R))
+    pin, disc = state.bodies[0].wear_volume.sum(), state.parts[0].volume.sum()
+    assert measured("pin on worn disc: pin volume (m³)", pin, K_PIN * P * s, 5e-3) <= 5e-3
+    assert measured("pin on worn disc: disc volume (m³)", disc, K_DISC * P * s, 5e-3) <= 5e-3
+    # the same pairs wear both: the volumes are in the ratio of the coefficients
+    assert disc / pin == pytest.approx(K_DISC / K_PIN, rel=1e-12)
+    # and dissipate one friction work, counted once on each part
+    assert state.parts[0].work.sum() == pytest.approx(state.bodies[0].friction_work.sum(),
+                                                      rel=1e-12)
+
+
+def test_the_disc_track_follows_the_chord_law(two_turns, measured):
+    """A disc point at offset u from the track's centre line spends the arc
+    c(u) of its circle under the pin per turn (:func:`cases.arc_chord`; the
+    chord 2 sqrt(a² - u²) for R >> a): its depth is k p c(u) per turn,
+    p = P / pi a² (uniform: the track stays far shallower than the elastic
+    approach p / K), projected on the disc mesh."""
+    model, state = two_turns
+    disc, part = model.surfaces.per_vertex[0], state.parts[0]
+    p = P / (np.pi * A * A)
+    turns = OMEGA * state.time / (2.0 * np.pi)
+    centre = K_DISC * p * 2.0 * A * turns
+    assert centre < 0.02 * p / 1e13
+    expected, u = cases.disc_track(disc.reference_vertices, disc.faces, 0.001, R, A, p, K_DISC,
+                                   turns)
+    track = (np.abs(disc.reference_vertices[:, 2] - 0.001) < 1e-9) & (np.abs(u) < 0.8 * A)
+    assert track.sum() > 500
+    error = np.abs(part.depth[track] - expected[track]).max() / centre
+    assert measured("disc track vs chord law (of centre depth)", error, 0.0, 5e-2) <= 5e-2
+
+
+def test_compiled_loop_matches_the_python_step_on_a_worn_disc(tmp_path):
+    model = build_model(load_scene(_scene(tmp_path, duration=0.1)))
+    a = run(model, initial_state(model))
+    parts_a = copy.deepcopy(a.parts[0])
+    b = run(model, initial_state(model), compiled=False)
+    assert np.array_equal(parts_a.depth, b.parts[0].depth)
+    assert np.array_equal(parts_a.vertices, b.parts[0].vertices)
+    assert np.array_equal(a.bodies[0].wear_depth, b.bodies[0].wear_depth)
+
+
+def test_outputs_of_a_worn_surface(tmp_path):
+    out = tmp_path / "out"
+    assert main(["run", str(_scene(tmp_path, duration=0.1)), "-o", str(out), "-q"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    disc, pin = summary["surfaces"]["disc"], summary["bodies"]["pin"]
+    assert disc["wear_volume"] > 0.0 and disc["max_wear_depth"] > 0.0
+    assert disc["friction_work"] == pytest.approx(pin["friction_work"], rel=1e-12)
+    # the contact forces on the two parts are equal and opposite
+    np.testing.assert_allclose(disc["contact_force"], -np.array(pin["contact_force"]),
+                               rtol=1e-9, atol=1e-12)
+    rows = (out / "history.csv").read_text().splitlines()
+    assert sum(line.split(",")[1] == "disc" for line in rows[1:]) == 5
+    frames = sorted((out / "disc").glob("*.vtp"))
+    assert len(frames) == 3 and (out / "disc.pvd").is_file()
+    last = pyvista.read(frames[-1])
+    for field in ("wear_depth", "normal_force", "friction_force", "pressure", "contact_state",
+                  "friction_work"):
+        assert field in last.point_data
+    # the pairs' normal forces, shared among the disc's vertices: the load
+    # (along the worn faces' normals, a few 1e-7 rad off the axis)
+    assert last.point_data["normal_force"].sum() == pytest.approx(pin["contact_force"][2],
+                                                                  rel=1e-5)
+
+
+def test_a_checkpoint_carries_the_counter_wear(tmp_path):
+    model = build_model(load_scene(_scene(tmp_path, duration=0.1)))
+    full = run(model, initial_state(model))
+    depth = full.parts[0].depth.copy()
+    half = initial_state(model)
+    from meshwear.simulate import advance
+    advance(model, half, model.n_steps // 2)
+    checkpoint.save(tmp_path / "c.npz", model, half, 0.0)
+    resumed = initial_state(model)
+    checkpoint.load(tmp_path / "c.npz", model, resumed)
+    assert resumed.parts[0].depth.max() > 0.0
+    run(model, resumed)
+    assert np.abs(resumed.parts[0].depth - depth).max() <= 1e-9 * depth.max()
+
+
+def test_a_counter_worn_faster_than_its_mesh_can_follow_stops(tmp_path):
+    model = build_model(load_scene(_scene(tmp_path, duration=0.1, coefficient=1e-3)))
+    with pytest.raises(NumericalError, match="surface 'disc'.*shortest edge"):
+        run(model, initial_state(model))
+
+
+@pytest.mark.parametrize("extra, key, text", [
+    ('[[surface]]\nname = "floor"\ntype = "plane"\nwear = true\n', "wear",
+     'does not apply to a type = "plane"'),
+])
+def test_wear_applies_to_mesh_surfaces_only(tmp_path, extra, key, text):
+    with pytest.raises(SceneError, match=text):
+        load_scene(_scene(tmp_path, extra=extra))
+
+
+def test_a_law_without_wear_is_refused(tmp_path):
+    path = _scene(tmp_path)
+    path.write_text(path.read_text().replace("wear = true\ncoefficient = 2e-13",
+                                             'law = "energy"'))
+    with pytest.raises(SceneError, match="surface\\[0\\].law.*add wear = true"):
+        load_scene(path)
+
+
+def test_cycle_jumps_over_a_worn_surface_are_refused(tmp_path):
+    path = _scene(tmp_path)
+    path.write_text(path.read_text().replace('law = "archard"',
+                                             'law = "archard"\nacceleration = "cycle_jump"'))
+    with pytest.raises(SceneError, match="surface\\[0\\].wear.*cannot be cycle-jumped"):
+        build_model(load_scene(path))
+
+
+def test_a_surface_frame_s_orientation_is_its_turn():
+    """The history and summary give a worn surface's orientation as a
+    quaternion of its frame's rotation (near half turns included)."""
+    from meshwear.output.fields import _matrix_quaternion
+    from meshwear.surfaces.base import axis_rotation, quaternion_matrix
+
+    rng = np.random.default_rng(5)
+    for k in range(200):
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        angle = np.pi - rng.uniform(0.0, 1e-3) if k % 2 else rng.uniform(0.0, np.pi)
+        rotation = axis_rotation(axis, angle)
+        q = _matrix_quaternion(rotation)
+        assert q[0] >= 0.0 and abs(np.linalg.norm(q) - 1.0) < 1e-12
+        np.testing.assert_allclose(quaternion_matrix(q), rotation, atol=1e-12)
