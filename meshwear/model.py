@@ -314,8 +314,9 @@ def _periods(scene):
     """Cycle lengths (s) of the bodies' and mesh surfaces' periodic motions."""
     out = [Path(x.path).period for x in scene.bodies + scene.surfaces
            if getattr(x, "path", None) is not None]
-    out += [2.0 * np.pi / abs(s.rotation.rate) for s in scene.surfaces
-            if getattr(s, "rotation", None) is not None and s.rotation.rate != 0.0]
+    turns = ([s.rotation for s in scene.surfaces]
+             + [b.path.rotation for b in scene.bodies if b.path is not None])
+    out += [2.0 * np.pi / abs(r.rate) for r in turns if r is not None and r.rate != 0.0]
     return [p for p in out if p is not None]
 
 
@@ -393,6 +394,10 @@ def _build_body(scene, index, body, surface_set):
         motion = PrescribedMotion(pose[0:3].copy(), path)
     else:
         motion = FixedMotion()
+    turning = body.path is not None and body.path.rotation is not None
+    if turning:
+        r = body.path.rotation
+        motion.set_turn(q, r.axis, r.rate, r.center)
     motion.place(pose, 0.0)
     if not np.all(np.isfinite(pose)):
         raise SceneError(scene.source, key, "initial pose is not finite")
@@ -414,8 +419,8 @@ def _faces_to_refine(scene, body, vertices, faces, surface_set):
     """Faces ``resolution`` refines: all of a free body (it may land on any
     face); of a guided, prescribed or fixed one (which only translates) the
     faces that face a surface within :data:`REFINE_REACH` of its size at the
-    start (its path's displacement included)."""
-    if body.motion == "free":
+    start (its path's displacement included); all of one that turns."""
+    if body.motion == "free" or (body.path is not None and body.path.rotation is not None):
         return None
     R = np.array(rotation_entries(np.asarray(body.orientation, float))).reshape(3, 3)
     points = vertices @ R.T + np.asarray(body.position, float) + Path(body.path).displacement(0.0)

@@ -24,7 +24,8 @@ import numpy as np
 from .kernels.balance import balance_offset
 from .kernels.rigid import (ACCELERATION, AXIS, BALANCED, CARRIED, CIRCLE, FIXED, FREE, GUIDED,
                             INERTIA, INVERSE_INERTIA, INVERSE_MASS, MOTION_PARAMS, OSCILLATION,
-                            PRESCRIBED, START, STEADY, advance_motion, path_point, place_motion)
+                            ORIENTATION, PRESCRIBED, START, STEADY, TURN_AXIS, TURN_CENTER,
+                            TURN_RATE, advance_motion, path_point, place_motion)
 
 
 class Path:
@@ -86,7 +87,7 @@ NO_SCALE = np.zeros(0)
 
 class Motion:
     """A motion as the kernels see it: its ``kind`` (:mod:`meshwear.kernels.rigid`),
-    ``params`` (29,) and path ``terms``; :meth:`place` and :meth:`advance`
+    ``params`` (40,) and path ``terms``; :meth:`place` and :meth:`advance`
     call the same kernels as the compiled step loop."""
 
     kind = FIXED
@@ -104,6 +105,19 @@ class Motion:
         self.params[AXIS] = axis
         self.params[START] = start
         self.params[CARRIED] = carried
+
+    def set_turn(self, orientation, axis, rate, center):
+        """A steady turn (:func:`meshwear.kernels.rigid.turn`): ``orientation``
+        at t = 0 (quaternion), unit ``axis``, ``rate`` (rad/s) and the point
+        it turns about at t = 0 (m, carried along the path)."""
+        self.params[ORIENTATION] = orientation
+        self.params[TURN_AXIS] = axis
+        self.params[TURN_RATE] = rate
+        self.params[TURN_CENTER] = center
+
+    @property
+    def turn_rate(self):
+        return float(self.params[TURN_RATE])
 
     @property
     def terms(self):

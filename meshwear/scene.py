@@ -253,28 +253,33 @@ class Circle:
 class PathConfig:
     """``path``: displacement added to the initial position; the components given
     add up. ``velocity`` (m/s) is steady sliding; ``free_axis`` (unit) is the
-    free direction of a guided body."""
+    free direction of a guided body; ``rotation`` a body's steady turn about
+    its ``center`` (carried along the path)."""
 
     oscillation: Oscillation | None = None
     velocity: tuple | None = None
     circle: Circle | None = None
     free_axis: tuple | None = None
+    rotation: "RotationConfig | None" = None
 
     def __post_init__(self):
         _set_optional(self, "oscillation", _instance, Oscillation)
         _set_optional(self, "velocity", _vector)
         _set_optional(self, "circle", _instance, Circle)
         _set_optional(self, "free_axis", _direction)
+        _set_optional(self, "rotation", _instance, RotationConfig)
 
     @property
     def periodic(self):
-        """True when the path has a cycle (an oscillation or a circle)."""
-        return self.oscillation is not None or self.circle is not None
+        """True when the path has a cycle (an oscillation, a circle or a turn)."""
+        return (self.oscillation is not None or self.circle is not None
+                or (self.rotation is not None and self.rotation.rate != 0.0))
 
 
 @dataclass(frozen=True, kw_only=True)
 class RotationConfig:
-    """Steady rotation of a mesh surface: unit ``axis``, ``rate`` (rad/s), ``center`` (m)."""
+    """Steady rotation of a surface or a body's path: unit ``axis``, ``rate``
+    (rad/s), ``center`` (m, a body's carried along its path)."""
 
     axis: tuple
     rate: float
@@ -404,6 +409,9 @@ class SurfaceConfig:
         if self.path is not None and self.path.free_axis is not None:
             raise SceneError("", "path.free_axis", "applies to guided bodies only; "
                                                    "a surface follows its path exactly")
+        if self.path is not None and self.path.rotation is not None:
+            raise SceneError("", "path.rotation", "a surface turns by its own rotation key, "
+                                                  "not its path's")
         own = set(SURFACE_KEYS[self.type])
         defaults = {f.name: f.default for f in dataclasses.fields(self)}
         for key in {k for keys in SURFACE_KEYS.values() for k in keys} - own:
@@ -682,7 +690,8 @@ def _shape(source, value, prefix):
 
 def _path(source, value, prefix):
     table = _table(source, value, prefix, PathConfig)
-    for key, cls in (("oscillation", Oscillation), ("circle", Circle)):
+    for key, cls in (("oscillation", Oscillation), ("circle", Circle),
+                     ("rotation", RotationConfig)):
         if key in table:
             table[key] = _simple(cls, table[key], f"{prefix}.{key}", source)
     return _build(PathConfig, source, prefix, table)

@@ -58,7 +58,7 @@ def _quasi_static_step(model, body, s, k):
     before = s.pose[0:3].copy()
     body.motion.place(s.pose, t)
     s.pose[7:10] = (s.pose[0:3] - before) / model.dt
-    s.pose[10:13] = 0.0
+    # (the angular velocity is the path's: zero, or a steady turn's)
     # the planes under the vertices where the path puts the body, then the
     # balance along its free axis on them
     surfaces.update(model, body, s, t)

@@ -287,3 +287,63 @@ def test_two_body_fretting_wears_each_part_its_k_load_sliding(tmp_path, measured
     # the stroke, the contact's half width (0.17 mm) and one mesh spacing
     assert np.abs(worn[:, 0]).max() <= 5e-4 + 1.7e-4 + 1.5e-4
     assert np.abs(worn[:, 0]).max() >= 5e-4
+
+
+SHAFT_IN_WORN_BUSHING = """format = 1
+[run]
+mode = "quasi-static"
+duration = 0.15708
+dt = 5e-4
+frames = 0
+history = 2
+gravity = [0.0, 0.0, 0.0]
+[contact]
+stiffness_per_area = 1e13
+friction = 0.3
+[wear]
+law = "archard"
+coefficient = 1e-13
+[[body]]
+name = "shaft"
+shape = { type = "cylinder", radius = 0.005, height = 0.005, sections = 256 }
+resolution = 2.5e-4
+density = 7850.0
+force = [-20.0, 0.0, 0.0]
+motion = "guided"
+[body.path]
+free_axis = [1.0, 0.0, 0.0]
+rotation = { axis = [0.0, 0.0, 1.0], rate = 10.0, center = [0.0, 0.0, 0.0] }
+[[surface]]
+name = "bushing"
+type = "mesh"
+mesh = "bushing.stl"
+wear = true
+coefficient = 3e-13
+"""
+
+
+def test_a_shaft_turning_in_a_worn_bushing(tmp_path, measured):
+    """A shaft (R = 5 mm) turning at 10 rad/s in a bushing (bore 5.05 mm,
+    1024 facets), pressed by 20 N across its axis: each part's worn volume is
+    its k P s, s = omega R t (a quarter turn), and the bushing wears on the
+    loaded side only."""
+    import trimesh
+
+    trimesh.creation.annulus(r_min=0.00505, r_max=0.008, height=0.003,
+                             sections=1024).export(tmp_path / "bushing.stl")
+    path = tmp_path / "shaft.toml"
+    path.write_text(SHAFT_IN_WORN_BUSHING)
+    model = build_model(load_scene(path))
+    state = run(model, initial_state(model))
+    s = 10.0 * 5e-3 * state.time
+    shaft, bushing = state.bodies[0].wear_volume.sum(), state.parts[0].volume.sum()
+    assert measured("shaft in worn bushing: shaft volume", shaft, 1e-13 * 20.0 * s, 5e-3) <= 5e-3
+    assert measured("shaft in worn bushing: bushing volume", bushing, 3e-13 * 20.0 * s,
+                    5e-3) <= 5e-3
+    worn = model.surfaces.per_vertex[0].reference_vertices[state.parts[0].depth > 0.0]
+    assert len(worn) > 10 and (worn[:, 0] < -0.004).all()
+    # the shaft turned by omega t about its axis, its centre pressed onto the bore
+    half = 0.5 * 10.0 * state.time
+    assert state.bodies[0].pose[3:7] == pytest.approx([np.cos(half), 0.0, 0.0, np.sin(half)],
+                                                      abs=1e-12)
+    assert -5.2e-5 < state.bodies[0].pose[0] < -5.0e-5

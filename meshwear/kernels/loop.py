@@ -174,8 +174,7 @@ def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, 
         place_motion(kind, params, path_terms, buffer, placed, t)
         for j in range(3):
             placed[7 + j] = (placed[j] - pose[j]) / dt
-        for j in range(10, 13):
-            placed[j] = 0.0
+        # (the angular velocity is the path's: zero, or a steady turn's)
         saved = pose.copy()
         for j in range(13):
             pose[j] = placed[j]

@@ -129,7 +129,8 @@ def path_point(terms, t, out):
 def place_on_path(pose, start, terms, axis, along, rate, t, buffer):
     """Put ``pose`` on its path at ``t``: ``start + path(t)`` across ``axis``,
     ``along`` (m) and ``rate`` (m/s) along it. A zero ``axis`` prescribes every
-    translation. Rotation stays; angular velocity is zero."""
+    translation. Rotation stays; angular velocity is zero (:func:`turn` adds
+    a steady turn)."""
     path_point(terms, t, buffer)
     across = 0.0
     speed = 0.0
@@ -164,10 +165,55 @@ def guided_step(pose, wrench, inverse_mass, acceleration, axis, start, terms, t,
 
 #: motion kinds of :func:`place_motion` and :func:`advance_motion`
 FIXED, FREE, GUIDED, PRESCRIBED, BALANCED = 0, 1, 2, 3, 4
-#: slots of a motion's ``params`` (29,)
+#: slots of a motion's ``params`` (40,): the mass terms, the free axis, the
+#: start, the load a balanced body carries, and a steady turn: the
+#: orientation at t = 0, the turn's unit axis, its rate (rad/s, 0: none) and
+#: the point it turns about at t = 0 (carried along the path)
 INVERSE_MASS, INERTIA, INVERSE_INERTIA, ACCELERATION, AXIS, START, CARRIED = (
     0, slice(1, 10), slice(10, 19), slice(19, 22), slice(22, 25), slice(25, 28), 28)
-MOTION_PARAMS = 29
+ORIENTATION, TURN_AXIS, TURN_RATE, TURN_CENTER = slice(29, 33), slice(33, 36), 36, slice(37, 40)
+MOTION_PARAMS = 40
+
+
+@njit(cache=True)
+def turn(pose, params, axis, t):
+    """A path-driven body's steady turn at ``t``, in place: its orientation
+    turned by ``rate t`` about the turn's axis, its angular velocity
+    ``rate axis``, and its centre of mass carried round the turn's centre
+    (that motion's component along a free ``axis`` left out: it is the
+    body's own)."""
+    rate = params[TURN_RATE]
+    if rate == 0.0:
+        return
+    ax, ay, az = params[33], params[34], params[35]
+    half = 0.5 * rate * t
+    c, s = np.cos(half), np.sin(half)
+    dw, dx, dy, dz = c, s * ax, s * ay, s * az
+    w, x, y, z = params[29], params[30], params[31], params[32]
+    pose[3] = dw * w - dx * x - dy * y - dz * z
+    pose[4] = dw * x + dx * w + dy * z - dz * y
+    pose[5] = dw * y - dx * z + dy * w + dz * x
+    pose[6] = dw * z + dx * y - dy * x + dz * w
+    ox, oy, oz = rate * ax, rate * ay, rate * az
+    pose[10], pose[11], pose[12] = ox, oy, oz
+    # the centre of mass about the turn's centre: r0 = start - centre, turned
+    rx, ry, rz = params[25] - params[37], params[26] - params[38], params[27] - params[39]
+    if rx == 0.0 and ry == 0.0 and rz == 0.0:
+        return
+    angle = rate * t
+    ca, sa = np.cos(angle), np.sin(angle)
+    along = ax * rx + ay * ry + az * rz
+    cx, cy, cz = ay * rz - az * ry, az * rx - ax * rz, ax * ry - ay * rx
+    tx = rx * ca + cx * sa + ax * along * (1.0 - ca)
+    ty = ry * ca + cy * sa + ay * along * (1.0 - ca)
+    tz = rz * ca + cz * sa + az * along * (1.0 - ca)
+    d = (tx - rx, ty - ry, tz - rz)
+    v = (oy * tz - oz * ty, oz * tx - ox * tz, ox * ty - oy * tx)
+    dn = d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2]
+    vn = v[0] * axis[0] + v[1] * axis[1] + v[2] * axis[2]
+    for j in range(3):
+        pose[j] += d[j] - dn * axis[j]
+        pose[7 + j] += v[j] - vn * axis[j]
 
 
 @njit(cache=True)
@@ -180,6 +226,7 @@ def place_motion(kind, params, terms, buffer, pose, t):
             pose[j] = 0.0
     elif kind == PRESCRIBED:
         place_on_path(pose, params[START], terms, np.zeros(3), 0.0, 0.0, t, buffer)
+        turn(pose, params, np.zeros(3), t)
     elif kind == GUIDED or kind == BALANCED:
         axis = params[AXIS]
         along = pose[0] * axis[0] + pose[1] * axis[1] + pose[2] * axis[2]
@@ -187,6 +234,7 @@ def place_motion(kind, params, terms, buffer, pose, t):
         if kind == GUIDED:
             rate = pose[7] * axis[0] + pose[8] * axis[1] + pose[9] * axis[2]
         place_on_path(pose, params[START], terms, axis, along, rate, t, buffer)
+        turn(pose, params, axis, t)
 
 
 @njit(cache=True)
@@ -199,5 +247,7 @@ def advance_motion(kind, params, terms, buffer, pose, wrench, t, dt):
     elif kind == GUIDED:
         guided_step(pose, wrench, params[INVERSE_MASS], params[ACCELERATION], params[AXIS],
                     params[START], terms, t, dt, buffer)
+        turn(pose, params, params[AXIS], t + dt)
     elif kind == PRESCRIBED:
         place_on_path(pose, params[START], terms, np.zeros(3), 0.0, 0.0, t + dt, buffer)
+        turn(pose, params, np.zeros(3), t + dt)
