@@ -121,8 +121,9 @@ def rotation_entries(q):
             2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y))
 
 
-#: set in the build for one analytic plane and no mesh surface (see _build)
-ONE_PLANE = False
+#: set in the build for one analytic plane and no per-vertex surface, and in
+#: the one for one per-vertex surface and no plane (see _build)
+ONE_PLANE = ONE_SURFACE = False
 
 
 def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear_direction,
@@ -132,6 +133,9 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
     if ONE_PLANE:
         # constant counts: LLVM drops the slot loop and the mesh branches
         n_planes = n_slots = 1
+    elif ONE_SURFACE:
+        # and here the plane branches
+        n_planes, n_slots = 0, 1
     else:
         n_planes = planes.shape[0]
         n_slots = n_planes + vertex_planes.shape[0]
@@ -354,18 +358,23 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
 
 
 #: the builds a copy of _dispatch calls, set per copy by _build
-GENERAL_BUILD = ONE_PLANE_BUILD = None
+GENERAL_BUILD = ONE_PLANE_BUILD = ONE_SURFACE_BUILD = None
 
 
 def _dispatch(body_vertices, pose, planes, vertex_planes, active, area, law, wear_direction,
               contact_state, tangential, normal_force,
               friction_work, wear_depth, wear_volume, wrench):
     """The kernel: GENERAL_BUILD, or ONE_PLANE_BUILD for one analytic plane
-    and no mesh surface (the same computation, compiled for that case)."""
+    and no per-vertex surface, or ONE_SURFACE_BUILD for one per-vertex surface
+    and no plane (the same computation, compiled for that case)."""
     if planes.shape[0] == 1 and vertex_planes.shape[0] == 0:
         ONE_PLANE_BUILD(body_vertices, pose, planes, vertex_planes, active, area, law,
                         wear_direction, contact_state, tangential, normal_force,
                         friction_work, wear_depth, wear_volume, wrench)
+    elif planes.shape[0] == 0 and vertex_planes.shape[0] == 1:
+        ONE_SURFACE_BUILD(body_vertices, pose, planes, vertex_planes, active, area, law,
+                          wear_direction, contact_state, tangential, normal_force,
+                          friction_work, wear_depth, wear_volume, wrench)
     else:
         GENERAL_BUILD(body_vertices, pose, planes, vertex_planes, active, area, law,
                       wear_direction, contact_state, tangential, normal_force,
@@ -397,12 +406,16 @@ _FLAGS = {"contract"}
 
 def _build(name, parallel):
     """``name``: the kernel, serial or threaded, dispatching to its general
-    build or to the one compiled for one analytic plane and no mesh surface."""
+    build or to the ones compiled for one analytic plane and no per-vertex
+    surface, and for one per-vertex surface and no plane."""
     options = dict(cache=True, fastmath=_FLAGS, error_model="numpy", parallel=parallel)
     general = njit(**options)(_named_copy(_contact, name + "_general"))
     one_plane = njit(**options)(_named_copy(_contact, name + "_one_plane", ONE_PLANE=True))
+    one_surface = njit(**options)(_named_copy(_contact, name + "_one_surface",
+                                              ONE_SURFACE=True))
     return njit(cache=True)(_named_copy(_dispatch, name, GENERAL_BUILD=general,
-                                        ONE_PLANE_BUILD=one_plane))
+                                        ONE_PLANE_BUILD=one_plane,
+                                        ONE_SURFACE_BUILD=one_surface))
 
 
 contact_serial = _build("contact_serial", parallel=False)
