@@ -347,3 +347,29 @@ def test_a_shaft_turning_in_a_worn_bushing(tmp_path, measured):
     assert state.bodies[0].pose[3:7] == pytest.approx([np.cos(half), 0.0, 0.0, np.sin(half)],
                                                       abs=1e-12)
     assert -5.2e-5 < state.bodies[0].pose[0] < -5.0e-5
+
+
+@pytest.mark.parametrize("law, coefficient", [("energy_density", 3e-9), ("energy", 2e-3)])
+def test_a_counter_s_own_energy_law_conserves(tmp_path, law, coefficient):
+    """A worn surface's own law: ``energy_density`` wears the volume k E,
+    ``energy`` the depth k E at each contact (its volume k E times the
+    contact's area), E the friction work of the pairs (the body's)."""
+    path = _scene(tmp_path, duration=0.1)
+    path.write_text(path.read_text().replace(
+        "coefficient = 2e-13", f'law = "{law}"\ncoefficient = {coefficient}'))
+    model = build_model(load_scene(path))
+    state = run(model, initial_state(model))
+    part, body = state.parts[0], state.bodies[0]
+    work = body.friction_work.sum()
+    assert part.work.sum() == pytest.approx(work, rel=1e-12)
+    if law == "energy_density":
+        assert part.volume.sum() == pytest.approx(coefficient * work, rel=1e-9)
+    else:
+        # k E per contact times its area: between k E times the smallest and
+        # the largest contact area of the pin's vertices
+        areas = -model.bodies[0].area_vectors[body.normal_force[0] > 0.0, 2]
+        assert coefficient * work * areas.min() <= part.volume.sum()
+        assert part.volume.sum() <= coefficient * work * areas.max()
+    # the pin keeps its own Archard wear: k_pin P s
+    s = OMEGA * state.time * (R + A * A / (8.0 * R))
+    assert body.wear_volume.sum() == pytest.approx(K_PIN * P * s, rel=5e-3)
