@@ -268,7 +268,7 @@ def closest_points(tri, points):
 
 def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
                    face_normals, corner_normals, reach, out, distance, hint, fixed=False,
-                   tracking=0.5, tie=1e-9):
+                   tracking=0.5, tie=1e-9, release=16.0):
     """Same contract as :func:`meshwear.kernels.nearest.nearest_planes`, by
     brute force over every face (no grid); ``fixed`` only lets the kernel
     reuse what it wrote, so the twin ignores it."""
@@ -300,11 +300,16 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
         over = lateral <= 1e-9 * reach
         eligible = within & over & (face_normals @ prev >= tracking)
         h = hint[i]
-        if tracked and h >= 0 and eligible[h]:
+        nearest = pick(within)
+        if tracked and h >= 0 and eligible[h] and not (
+                delta[h] < 0.0 and -delta[h] > release * _inside(tri[h], foot[h])):
             kept = h                  # still over the face it had: it stays there
         else:
             kept = pick(eligible) if tracked else -1
-        best = kept if kept >= 0 else pick(within)
+            if (kept >= 0 and delta[kept] < 0.0
+                    and delta[kept] ** 2 > release ** 2 * d2[nearest]):
+                kept = -1             # deep under it, near another face: let go
+        best = kept if kept >= 0 else nearest
         hint[i] = best
         if best < 0:
             out[i] = 0.0
@@ -322,6 +327,18 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
         out[i, 0] = p
         out[i, 1] = rotation @ normal
         out[i, 2] = motion[1] + np.cross(motion[2], p - motion[3])
+
+
+def _inside(tri, foot):
+    """Distance (>= 0) from a foot inside triangle ``tri`` to its nearest edge line."""
+    n = np.cross(tri[1] - tri[0], tri[2] - tri[0])
+    n /= np.linalg.norm(n)
+    out = np.inf
+    for k in range(3):
+        p, q = tri[k], tri[(k + 1) % 3]
+        m = np.cross(q - p, n)
+        out = min(out, -float((foot - p) @ m) / np.linalg.norm(m))
+    return max(out, 0.0)
 
 
 # ---------------------------------------------------------------- counter-surfaces

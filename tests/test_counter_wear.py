@@ -373,3 +373,57 @@ def test_a_counter_s_own_energy_law_conserves(tmp_path, law, coefficient):
     # the pin keeps its own Archard wear: k_pin P s
     s = OMEGA * state.time * (R + A * A / (8.0 * R))
     assert body.wear_volume.sum() == pytest.approx(K_PIN * P * s, rel=5e-3)
+
+
+DISC_OVER_A_WORN_PIN = """format = 1
+[run]
+mode = "quasi-static"
+duration = 0.1
+dt = 2e-3
+frames = 0
+history = 2
+gravity = [0.0, 0.0, 0.0]
+[contact]
+stiffness_per_area = 1e13
+friction = 0.4
+[wear]
+law = "archard"
+coefficient = 2e-13
+[[body]]
+name = "disc"
+shape = { type = "cylinder", radius = 0.008, height = 0.002, sections = 64 }
+resolution = 3e-4
+density = 7850.0
+position = [0.0, 0.0, 0.001]
+force = [0.0, 0.0, -10.0]
+motion = "guided"
+[body.path]
+free_axis = [0.0, 0.0, 1.0]
+rotation = { axis = [0.0, 0.0, 1.0], rate = 10.0, center = [0.0, 0.0, 0.0] }
+[[surface]]
+name = "pin"
+type = "mesh"
+shape = { type = "cylinder", radius = 0.001, height = 0.003, sections = 24 }
+resolution = 1.5e-4
+position = [0.005, 0.0, -0.0015]
+wear = true
+coefficient = 1e-13
+"""
+
+
+def test_a_turning_body_swept_over_a_counter_part_s_edge_rests_on_its_top(tmp_path):
+    """The pin-on-disc the other way round: the disc is the turning body,
+    pressed on a worn pin. Its vertices sweep in over the pin's edge at the
+    depth of the elastic approach, nearer the side face at first; deep under
+    it, they let go of it for the top face (nearest.RELEASE), so the disc
+    stays in balance on the pin's top (it sank through the pin before)."""
+    path = tmp_path / "disc_over_pin.toml"
+    path.write_text(DISC_OVER_A_WORN_PIN)
+    model = build_model(load_scene(path))
+    state = run(model, initial_state(model))
+    s = state.bodies[0]
+    touching = s.normal_force[0] > 0.0
+    assert touching.sum() > 30
+    assert s.vertex_planes[0][touching][:, 1, 2].min() > 0.999
+    assert 0.000999 < s.pose[2] < 0.001
+    assert state.parts[0].volume.sum() / s.wear_volume.sum() == pytest.approx(0.5, rel=1e-12)

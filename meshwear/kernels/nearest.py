@@ -51,6 +51,18 @@ TIE = 1e-9
 #: nearest face, as an untracked vertex does.
 TRACKING = 0.5
 
+#: a vertex lets go of the face it keeps (TRACKING) once it is deeper under
+#: that face than this many times its distance to the nearest face: a vertex
+#: swept sideways into a counter-part at the depth of the elastic approach
+#: (a turning body passing over a pin's edge) came in through the side face
+#: but belongs to the top one (hundreds of times deeper under the side than
+#: under the top); a vertex pressed into a face near its edge (depth a few
+#: times its distance to the edge) or most of the way through a thin plate
+#: (94 %) keeps its face. The check costs a scan only where the vertex is
+#: deeper under its face than this many times the foot's distance to the
+#: face's edges.
+RELEASE = 16.0
+
 #: a vertex is over a face when the foot of it on the face's plane lies in
 #: the triangle or less than this fraction of the reach outside it (an edge
 #: between two faces belongs to both)
@@ -171,7 +183,8 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             # normal the vertex holds is that face's own, TRACKING holds)
             if (delta * delta <= reach2 and outside <= over
                     and ((fixed and flat)
-                         or _along(frames, h, 0, tx, ty, tz) + frames[h, 0, 3] >= TRACKING)):
+                         or _along(frames, h, 0, tx, ty, tz) + frames[h, 0, 3] >= TRACKING)
+                    and not (delta < 0.0 and -delta > RELEASE * max(-outside, 0.0))):
                 kept, kept_d2, kept_delta = h, delta * delta, delta
                 by_hint = True
         if kept < 0:
@@ -212,6 +225,9 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
                 tie = TIE * max(d2, kept_d2 if kept >= 0 else d2)
                 if kept < 0 or d2 < kept_d2 - tie or (d2 <= kept_d2 + tie and delta > kept_delta):
                     kept, kept_d2, kept_delta = f, d2, delta
+        if (kept >= 0 and not by_hint and kept_delta < 0.0 and best >= 0
+                and kept_delta * kept_delta > RELEASE * RELEASE * best_d2):
+            kept = -1                    # deep under it, near another face: let go
         if kept >= 0:
             best, best_d2, best_delta = kept, kept_d2, kept_delta
         hint[i] = best
@@ -304,7 +320,8 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
     face's index; zeros, ``inf`` and -1 where no face qualifies. A vertex that
     had a plane (``out[i]`` nonzero on entry) keeps to faces whose normal is
     within 60 degrees of the one it had while it is over one of them
-    (:data:`TRACKING`), and to face ``hint[i]`` itself while it is over it.
+    (:data:`TRACKING`), and to face ``hint[i]`` itself while it is over it,
+    unless it is :data:`RELEASE` times deeper under it than near another face.
     ``fixed``: the surface's ``rotation`` is the one of the call that filled
     ``out`` (a fixed or frozen surface), so a vertex that keeps its face
     keeps the normal it holds."""
