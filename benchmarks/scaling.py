@@ -325,8 +325,8 @@ def write_docs(rows, ref, size_ratio, top, box, fine, sliding, turning):
               f"{turning['at rest', 'disc mesh']:.2f}×.",
               "  The mesh's extra is the face under each vertex, looked up every step (a",
               "  vertex keeps its face while it is over it: a few dot products, but a pass over",
-              "  the patch about as long as the contact kernel's); over four runs on this",
-              "  shared 2-core machine that row was 1.39–1.44× (the contact kernel is compiled",
+              "  the patch about as long as the contact kernel's); over eight runs on this",
+              "  shared 2-core machine that row was 1.36–1.50× (the contact kernel is compiled",
               "  for one per-vertex surface, as for one plane).",
               "", MARK_END]
     perf = ROOT / "docs" / "performance.md"
