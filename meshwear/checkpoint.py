@@ -28,8 +28,11 @@ _PART_ARRAYS = ("vertices", "frames", "depth", "volume", "work")
 
 
 def scene_digest(scene):
-    """SHA-256 of the scene file and every mesh file it reads (bodies' and surfaces')."""
+    """SHA-256 of the scene file, the keys set over it (``--set``) and every
+    mesh file it reads (bodies' and surfaces')."""
     h = hashlib.sha256()
+    if getattr(scene, "overrides", ()):
+        h.update(repr(tuple(scene.overrides)).encode())
     paths = [Path(scene.source)] + [Path(x.mesh) for x in scene.bodies + scene.surfaces
                                     if getattr(x, "mesh", None) is not None]
     for path in paths:

@@ -26,11 +26,13 @@ def main(argv=None):
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.add_argument("--resume", action="store_true",
                    help="continue the stopped run in OUT from its last checkpoint")
+    _set_option(p)
     p.add_argument("--checkpoint-every", type=float, default=60.0, metavar="SECONDS",
                    help="save a checkpoint at most this often (wall clock; default 60, 0: as "
                         "often as possible)")
     p = sub.add_parser("check", help="validate a scene and estimate its cost")
     p.add_argument("scene")
+    _set_option(p)
     p = sub.add_parser("demo", help="run the built-in demo scene")
     p.add_argument("-o", "--out", default="out/demo")
     p.add_argument("-q", "--quiet", action="store_true")
@@ -50,14 +52,15 @@ def main(argv=None):
         if args.command == "run":
             if args.checkpoint_every < 0:
                 raise InputError(f"--checkpoint-every: must be >= 0, got {args.checkpoint_every:g}")
-            return _run(args.scene, args.out, args.quiet, args.resume, args.checkpoint_every)
+            return _run(args.scene, args.out, args.quiet, args.resume, args.checkpoint_every,
+                        _overrides(args.set))
         if args.command == "demo":
             from importlib.resources import files
 
             scene = files("meshwear") / "data" / "demo.toml"
             return _run(str(scene), args.out, args.quiet)
         if args.command == "check":
-            return _check(args.scene)
+            return _check(args.scene, _overrides(args.set))
         return _info(args.mesh, args.units)
     except (SceneError, MeshError, InputError) as err:
         print(f"meshwear: error: {err}", file=sys.stderr)
@@ -67,22 +70,34 @@ def main(argv=None):
         return 130
 
 
-def _prepare(scene_path):
+def _set_option(parser):
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="set a scene key over the file's, by its dotted name "
+                             "(wear.coefficient=1e-13, body[0].force=[0,0,-20]); repeatable")
+
+
+def _overrides(texts):
+    from .scene import parse_override
+
+    return tuple(parse_override(text) for text in texts)
+
+
+def _prepare(scene_path, overrides=()):
     from .model import build_model, check_time_step
     from .scene import load_scene
 
-    scene = load_scene(scene_path)
+    scene = load_scene(scene_path, overrides)
     model = build_model(scene)
     return scene, model, check_time_step(model)
 
 
-def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0):
+def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=()):
     from . import checkpoint
     from .model import initial_state
     from .output.recorder import RunRecorder, summary
     from .simulate import NumericalError, run
 
-    scene, model, _ = _prepare(scene_path)
+    scene, model, _ = _prepare(scene_path, overrides)
     out_dir = Path(out) if out else Path("out") / Path(scene_path).stem
     state = initial_state(model)
     wall_before = 0.0
@@ -138,14 +153,16 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0):
     return EXIT_OK
 
 
-def _check(scene_path):
+def _check(scene_path, overrides=()):
     import numpy as np
 
     from . import stepper
     from .model import initial_state
 
-    scene, model, limit = _prepare(scene_path)
+    scene, model, limit = _prepare(scene_path, overrides)
     print(f"scene {scene.source}: ok (format 1, mode {scene.run.mode})")
+    for key, value in overrides:
+        print(f"  set {key} = {value!r}")
     for b, config in zip(model.bodies, scene.bodies):
         mass = f"{b.mass:.6g} kg" if np.isfinite(b.mass) else "n/a (open mesh, not integrated)"
         print(f"  body {b.name!r}: {len(b.tributary_area)} contact points, {len(b.faces)} faces, "

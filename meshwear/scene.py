@@ -475,6 +475,8 @@ class Scene:
     wear: WearConfig = field(default_factory=WearConfig)
     bodies: tuple = ()
     surfaces: tuple = ()
+    #: (key, value) pairs set over the file's (``--set``), part of its identity
+    overrides: tuple = ()
 
     def __post_init__(self):
         def fail(key, message):
@@ -535,13 +537,18 @@ def _check_format(value):
 
 # ------------------------------------------------------------------ parser
 
-def load_scene(path) -> Scene:
+def load_scene(path, overrides=()) -> Scene:
     """Read and validate a scene file.
 
     Parameters
     ----------
     path : str or os.PathLike
         TOML file; mesh paths in it are relative to its folder.
+    overrides : sequence of (key, value)
+        Keys to set before validation, by their dotted names (the names the
+        errors print: ``wear.coefficient``, ``body[0].force``,
+        ``surface[1].path.oscillation.amplitude``); values as parsed TOML
+        values (:func:`parse_override` turns ``KEY=VALUE`` text into one).
 
     Returns
     -------
@@ -573,7 +580,77 @@ def load_scene(path) -> Scene:
         location = where.group(1) if where else ""
         message = message[:where.start()] if where else message
         raise SceneError(source, location, f"TOML syntax error: {message}") from None
-    return parse_scene(data, source, path.resolve().parent)
+    for key, value in overrides:
+        set_key(data, key, value, source)
+    scene = parse_scene(data, source, path.resolve().parent)
+    object.__setattr__(scene, "overrides", tuple(overrides))
+    return scene
+
+
+_PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?:\[(\d+)\])?$")
+
+
+def parse_override(text):
+    """``KEY=VALUE`` (the command line's ``--set``) as ``(key, value)``: the
+    value is read as a TOML value (``1e-13``, ``[0, 0, -10]``, ``true``,
+    ``"archard"``, ``{ axis = [0, 0, 1], rate = 10 }``), or else taken as a
+    bare string (``quasi-static``).
+
+    Raises
+    ------
+    SceneError
+        For text without ``=`` or an empty key.
+    """
+    key, sep, value = text.partition("=")
+    key = key.strip()
+    if not sep or not key:
+        raise SceneError("--set", text, "expected KEY=VALUE, e.g. wear.coefficient=1e-13")
+    try:
+        parsed = tomllib.loads(f"v = {value.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        parsed = value.strip()
+    return key, parsed
+
+
+def set_key(data, key, value, source="<scene>"):
+    """Set ``key`` (dotted, with ``[i]`` for the i-th body or surface) in the
+    parsed TOML ``data`` to ``value``, creating the tables on the way.
+
+    Raises
+    ------
+    SceneError
+        Naming the key: an index past the bodies or surfaces there are, or a
+        part of the path that is not a table.
+    """
+    node = data
+    parts = key.split(".")
+    for n, part in enumerate(parts):
+        match = _PART.match(part)
+        if not match:
+            raise SceneError(source, key, f"--set: {part!r} is not a key name or name[index]")
+        name, index = match.group(1), match.group(2)
+        last = n == len(parts) - 1
+        where = ".".join(parts[:n + 1])
+        if not isinstance(node, dict):
+            raise SceneError(source, key, f"--set: {'.'.join(parts[:n])} is not a table")
+        if index is not None:
+            items = node.get(name)
+            if not isinstance(items, list) or int(index) >= len(items):
+                count = len(items) if isinstance(items, list) else 0
+                raise SceneError(source, key, f"--set: there is no {name}[{index}]; the scene "
+                                              f"has {count} [[{name}]] table(s)")
+            if last:
+                items[int(index)] = value
+                return
+            node = items[int(index)]
+        elif last:
+            node[name] = value
+        else:
+            if name not in node:
+                node[name] = {}
+            node = node[name]
+            if not isinstance(node, dict):
+                raise SceneError(source, key, f"--set: {where} is not a table")
 
 
 def parse_scene(data: dict, source: str = "<scene>", base_dir: Path = Path(".")) -> Scene:
