@@ -19,6 +19,8 @@ from dataclasses import dataclass
 
 import fcl
 import numpy as np
+from numba import njit
+from numba.typed import List
 
 from ..kernels.contact import FACING, FORCE, NO_CONTACT
 from ..kernels.frames import (BOUNDS_SIZE, MOTION_SIZE, moved_since_refresh as _moved,
@@ -99,12 +101,14 @@ class SurfaceSet:
         tuples = [s.compiled() for s in self.per_vertex]
         ids = [id(t) for t in tuples]
         if getattr(self, "_list_ids", None) != ids:
-            from numba import typed, typeof
-
-            item = typeof(tuples[0] if tuples else _sample_tuple())
-            self._list = typed.List.empty_list(item)
-            for t in tuples:
-                self._list.append(t)
+            # built by cached compiled functions: a typed list built from
+            # Python compiles its methods anew in every process (1 s here)
+            if tuples:
+                self._list = _list_of(tuples[0])
+                for t in tuples[1:]:
+                    _append(self._list, t)
+            else:
+                self._list = _empty_list_of(_sample_tuple())
             self._list_ids = ids
         return self._list
 
@@ -156,6 +160,28 @@ class SurfaceSet:
         out = [self.meshes[j] for j in sorted(found)]
         self._near = (key, out)
         return out
+
+
+@njit(cache=True)
+def _list_of(item):
+    """A typed list holding ``item``."""
+    out = List()
+    out.append(item)
+    return out
+
+
+@njit(cache=True)
+def _append(items, item):
+    items.append(item)
+
+
+@njit(cache=True)
+def _empty_list_of(sample):
+    """An empty typed list of ``sample``'s type."""
+    out = List()
+    out.append(sample)
+    out.pop()
+    return out
 
 
 def _sample_tuple():
