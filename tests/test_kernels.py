@@ -447,3 +447,36 @@ def test_a_reversal_step_longer_than_the_unloading_slips_again_at_once():
     pose[7] = 1e-20
     _call(contact.contact, *args, a)
     assert a["contact_state"][0, 0] == contact.STICK
+
+
+def test_a_steady_turn_matches_its_numpy_twin():
+    """rigid.turn: the orientation turned by rate t about the axis, the
+    angular velocity rate axis, and the centre of mass carried round the
+    turn's centre (less its component along a free axis)."""
+    from meshwear.kernels import rigid
+    from meshwear.surfaces.base import axis_rotation, quaternion_matrix
+
+    rng = np.random.default_rng(3)
+    for free in (np.zeros(3), np.array([0.0, 0.6, 0.8])):
+        params = np.zeros(rigid.MOTION_PARAMS)
+        q0 = rng.normal(size=4)
+        q0 /= np.linalg.norm(q0)
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        start, centre = rng.normal(size=3), rng.normal(size=3)
+        params[rigid.ORIENTATION], params[rigid.TURN_AXIS] = q0, axis
+        params[rigid.TURN_RATE], params[rigid.TURN_CENTER] = 3.0, centre
+        params[rigid.START] = start
+        for t in (0.0, 0.4, 1.7):
+            pose = np.zeros(13)
+            pose[0:3] = start
+            rigid.turn(pose, params, free, t)
+            R = axis_rotation(axis, 3.0 * t)
+            np.testing.assert_allclose(quaternion_matrix(pose[3:7]), R @ quaternion_matrix(q0),
+                                       atol=1e-12)
+            np.testing.assert_allclose(pose[10:13], 3.0 * axis, atol=1e-15)
+            moved = R @ (start - centre) + centre - start
+            speed = np.cross(3.0 * axis, R @ (start - centre))
+            np.testing.assert_allclose(pose[0:3], start + moved - (moved @ free) * free,
+                                       atol=1e-12)
+            np.testing.assert_allclose(pose[7:10], speed - (speed @ free) * free, atol=1e-12)
