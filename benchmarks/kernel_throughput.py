@@ -7,7 +7,7 @@ stick, slip and reverse like a real fretting contact. Compile time is reported
 apart from the steady state. Prints a table, then the kernel against the
 machine's memory bandwidth (a roofline: the bytes the kernel moves per
 vertex-step, counted in :data:`TRAFFIC`, against a STREAM triad measured in the
-same run), then one JSON line (DESIGN.md §6).
+same run), then one JSON line (docs/performance.md).
 
     python benchmarks/kernel_throughput.py [--sizes 10000 100000 1000000]
 """

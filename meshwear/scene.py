@@ -1,6 +1,6 @@
 """Scene files (TOML, format 1) → frozen, validated dataclasses.
 
-The TOML tables map one to one onto the dataclasses below (DESIGN.md §3).
+The TOML tables map one to one onto the dataclasses below (docs/scene-format.md).
 Every value is checked in the dataclass's ``__post_init__``, so
 ``dataclasses.replace`` makes a checked variant for sweeps; the parser only
 checks the key names, resolves mesh paths and builds nested tables. Bad input

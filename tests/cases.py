@@ -1,5 +1,5 @@
 """Validation cases: an example scene each, run and compared with its closed
-form (DESIGN.md §1) at the tolerance of §6.
+form (docs/model.md) at the tolerance of docs/validation.md.
 
 ``tests/test_validation.py`` asserts every row; ``benchmarks/validate.py``
 runs the same functions, writes ``docs/validation.md`` and draws the plots

@@ -1,4 +1,4 @@
-"""End-to-end tests of the command line (DESIGN.md §3 errors, §5 outputs, §7).
+"""End-to-end tests of the command line (docs/scene-format.md errors, docs/outputs.md outputs and exit codes).
 
 Most tests call :func:`meshwear.cli.main` in-process and read its output with
 capsys; one runs the installed ``meshwear`` console script in a subprocess.
@@ -27,14 +27,14 @@ from vtk.util.numpy_support import vtk_to_numpy
 from meshwear import geometry
 from meshwear.cli import main
 
-#: DESIGN.md §5: history.csv starts with these columns, in this order
+#: docs/outputs.md: history.csv starts with these columns, in this order
 HISTORY_COLUMNS = ["time", "body", "x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz",
                    "fx", "fy", "fz", "friction_work", "wear_volume", "max_wear_depth"]
-#: DESIGN.md §5: keys of summary.json and of each body in it
+#: docs/outputs.md: keys of summary.json and of each body in it
 SUMMARY_KEYS = {"format", "time", "steps", "cycles", "resolved_cycles", "wall_time", "bodies"}
 BODY_KEYS = {"wear_volume", "max_wear_depth", "friction_work", "position", "orientation",
              "velocity", "angular_velocity", "contact_force"}
-#: DESIGN.md §5: point data of every frame, and their number of components
+#: docs/outputs.md: point data of every frame, and their number of components
 POINT_DATA = {"wear_depth": 1, "normal_force": 1, "friction_force": 3, "pressure": 1,
               "contact_state": 1, "friction_work": 1}
 

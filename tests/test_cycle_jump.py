@@ -1,4 +1,4 @@
-"""Cycle jumping (DESIGN.md §4): the jump controller, its accuracy against
+"""Cycle jumping (docs/model.md, "Long durations"): the jump controller, its accuracy against
 fully resolved runs, and the hard case a volume check cannot see."""
 
 import dataclasses

@@ -1,4 +1,4 @@
-"""Mesh counter-surfaces, moving counter-bodies and the active set (DESIGN.md §2, §7).
+"""Mesh counter-surfaces, moving counter-bodies and the active set (docs/model.md).
 
 The mesh surface gives each vertex the plane of its nearest face, so a mesh
 whose faces lie in a plane must reproduce the plane's results; most checks

@@ -1,4 +1,4 @@
-"""VTK series, history.csv and JSON outputs (DESIGN.md §5)."""
+"""VTK series, history.csv and JSON outputs (docs/outputs.md)."""
 
 import csv
 import json

@@ -1,4 +1,4 @@
-"""Physics with known answers (DESIGN.md §1), at the tolerances of §6.
+"""Physics with known answers (docs/model.md), at the tolerances of docs/physics-tests.md.
 
 Every expected number comes from a closed form, never from an earlier run.
 """

@@ -1,5 +1,5 @@
 """Checkpoints and --resume: a run killed at any moment and resumed ends with
-the same numbers as a run never interrupted (DESIGN.md §4, issue: 1e-9)."""
+the same numbers as a run never interrupted (docs/outputs.md, "Checkpoints": 1e-9)."""
 
 import csv
 import dataclasses

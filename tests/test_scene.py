@@ -1,4 +1,4 @@
-"""Scene files (DESIGN.md §3): valid input maps onto the dataclasses with the
+"""Scene files (docs/scene-format.md): valid input maps onto the dataclasses with the
 documented defaults; bad input raises one SceneError line naming file and key."""
 
 import dataclasses

@@ -1,5 +1,5 @@
 """The validation cases of tests/cases.py (also the rows of docs/validation.md)
-at the tolerances of DESIGN.md §6."""
+at the tolerances of docs/validation.md."""
 
 import pytest
 

@@ -1,4 +1,4 @@
-"""Recorders: observers that turn a running state into the files of DESIGN.md §5.
+"""Recorders: observers that turn a running state into the files of docs/outputs.md.
 
 Physics never writes files; :func:`meshwear.simulate.run` calls
 ``on_sample`` / ``on_frame`` and the CLI calls ``close`` with the summary.
@@ -11,7 +11,7 @@ from .fields import body_quantities, body_totals, part_quantities
 from .tables import HISTORY_COLUMNS, HistoryWriter, write_json_atomic
 from .vtk import PVDSeries
 
-#: columns added to DESIGN.md §5's history.csv (extend, never rename)
+#: columns added to the history.csv of docs/outputs.md (extend, never rename)
 EXTRA_COLUMNS = ("wx", "wy", "wz", "tx", "ty", "tz", "contact_points", "stick_points", "slip_points",
                  "resolved")
 FIELDS = ("wear_depth", "normal_force", "friction_force", "pressure", "contact_state", "friction_work")
@@ -102,7 +102,7 @@ class RunRecorder:
 
 
 def summary(model, state, wall_time, status="ok", message=None):
-    """The ``summary.json`` object of DESIGN.md §5 (plus ``status``/``message``)."""
+    """The ``summary.json`` object of docs/outputs.md (plus ``status``/``message``)."""
     cycles = state.time / model.period if model.period else None
     out = {
         "format": 1,

@@ -1,4 +1,4 @@
-"""``history.csv`` and JSON files (DESIGN.md §5), written so an interrupted run leaves them valid."""
+"""``history.csv`` and JSON files (docs/outputs.md), written so an interrupted run leaves them valid."""
 
 import csv
 import json
@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-#: the columns DESIGN.md §5 fixes, in this order (others are appended, never renamed)
+#: the columns docs/outputs.md fixes, in this order (others are appended, never renamed)
 HISTORY_COLUMNS = ("time", "body", "x", "y", "z", "qw", "qx", "qy", "qz", "vx", "vy", "vz",
                    "fx", "fy", "fz", "friction_work", "wear_volume", "max_wear_depth")
 

@@ -1,4 +1,4 @@
-"""VTK time series for ParaView (DESIGN.md §5): a ``.pvd`` collection of ``.vtp`` frames.
+"""VTK time series for ParaView (docs/outputs.md): a ``.pvd`` collection of ``.vtp`` frames.
 
 ``OUT/<name>.pvd`` lists ``OUT/<name>/<name>_NNNNN.vtp``. The collection is
 rewritten atomically (temporary file, then ``os.replace``) after every frame, so
