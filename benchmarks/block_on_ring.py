@@ -22,7 +22,6 @@ line.
 import argparse
 import dataclasses
 import json
-import tempfile
 import time
 from pathlib import Path
 
@@ -33,10 +32,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from scipy.optimize import brentq  # noqa: E402
 
-from meshwear.model import build_model, check_time_step, initial_state  # noqa: E402
-from meshwear.output.recorder import RunRecorder, summary  # noqa: E402
+from common import replace_section, timed_run  # noqa: E402
 from meshwear.scene import load_scene  # noqa: E402
-from meshwear.simulate import run  # noqa: E402
 from meshwear.wear import error_estimate  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -44,20 +41,6 @@ ANALYTIC = ROOT / "examples" / "block_on_ring.toml"
 MESH = ROOT / "examples" / "block_on_ring_mesh.toml"
 PAGE = ROOT / "docs" / "examples" / "block_on_ring.md"
 MARK_START, MARK_END = "<!-- block_on_ring:start -->", "<!-- block_on_ring:end -->"
-
-
-def timed_run(scene):
-    """Build, run and write the outputs of ``scene``, as ``meshwear run``
-    does; return the model, the final state and the wall time."""
-    start = time.perf_counter()
-    model = build_model(scene)
-    check_time_step(model)
-    state = initial_state(model)
-    with tempfile.TemporaryDirectory() as out:
-        recorder = RunRecorder(out, model)
-        run(model, state, observers=[recorder])
-        recorder.close(summary(model, state, time.perf_counter() - start))
-    return model, state, time.perf_counter() - start
 
 
 def face(model, state):
@@ -78,7 +61,7 @@ def segment_depth(volume, radius, width):
 
 
 def measure(label, scene, converged=None):
-    model, state, wall = timed_run(scene)
+    model, state, _, wall = timed_run(scene)
     x, w = face(model, state)
     s = state.bodies[0]
     ring = next(c for c in scene.surfaces)
@@ -148,10 +131,7 @@ def write_page(rows):
     lines += ["", f"Mesh ring against analytic ring: the scars differ by at most "
               f"{m['mesh_vs_analytic']:.1e} of the depth.", "",
               "![the scar on the block](../img/block_on_ring_profile.png)", "", MARK_END]
-    text = PAGE.read_text()
-    section = "\n".join(lines)
-    text = text[:text.index(MARK_START)] + section + text[text.index(MARK_END) + len(MARK_END):]
-    PAGE.write_text(text)
+    replace_section(PAGE, MARK_START, MARK_END, "\n".join(lines))
 
 
 def main():

@@ -13,8 +13,6 @@ JSON line.
 """
 
 import json
-import tempfile
-import time
 from pathlib import Path
 
 import matplotlib
@@ -23,11 +21,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from common import replace_section, timed_run  # noqa: E402
 from meshwear.kernels.contact import rotation_entries  # noqa: E402
-from meshwear.model import build_model, check_time_step, initial_state  # noqa: E402
-from meshwear.output.recorder import RunRecorder, summary  # noqa: E402
 from meshwear.scene import load_scene  # noqa: E402
-from meshwear.simulate import run  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "cylinder_on_worn_flat.toml"
@@ -37,17 +33,8 @@ MARK_START, MARK_END = "<!-- cylinder_on_worn_flat:start -->", "<!-- cylinder_on
 
 
 def main():
-    started = time.perf_counter()
     scene = load_scene(SCENE)
-    model = build_model(scene)
-    check_time_step(model)
-    state = initial_state(model)
-    with tempfile.TemporaryDirectory() as out:
-        recorder = RunRecorder(out, model)
-        run(model, state, observers=[recorder])
-        result = summary(model, state, time.perf_counter() - started)
-        recorder.close(result)
-    wall = time.perf_counter() - started
+    model, state, result, wall = timed_run(scene)
     body, surface = scene.bodies[0], scene.surfaces[0]
     load = -body.force[2]
     amplitude = body.path.oscillation.amplitude
@@ -111,10 +98,7 @@ def write_page(r):
              f"{1e9 * r['flat_depth']:.1f} nm |",
              f"| contact forces on the two parts, summed | {r['force_sum']:.1e} N |",
              "", "![both scars](../img/cylinder_on_worn_flat.png)", "", MARK_END]
-    text = PAGE.read_text()
-    section = "\n".join(lines)
-    text = text[:text.index(MARK_START)] + section + text[text.index(MARK_END) + len(MARK_END):]
-    PAGE.write_text(text)
+    replace_section(PAGE, MARK_START, MARK_END, "\n".join(lines))
 
 
 if __name__ == "__main__":

@@ -20,8 +20,6 @@ docs/examples/pin_on_worn_disc.md, prints a table and, last, one JSON line.
 
 import json
 import sys
-import tempfile
-import time
 from pathlib import Path
 
 import matplotlib
@@ -30,10 +28,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from meshwear.model import build_model, check_time_step, initial_state  # noqa: E402
-from meshwear.output.recorder import RunRecorder, summary  # noqa: E402
+from common import replace_section, timed_run  # noqa: E402
 from meshwear.scene import load_scene  # noqa: E402
-from meshwear.simulate import run  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
@@ -46,18 +42,8 @@ MARK_START, MARK_END = "<!-- pin_on_worn_disc:start -->", "<!-- pin_on_worn_disc
 
 
 def main():
-    started = time.perf_counter()
     scene = load_scene(SCENE)
-    model = build_model(scene)
-    check_time_step(model)
-    state = initial_state(model)
-    with tempfile.TemporaryDirectory() as out:
-        recorder = RunRecorder(out, model)
-        run(model, state, observers=[recorder])
-        result = summary(model, state, time.perf_counter() - started)
-        recorder.close(result)
-    wall = time.perf_counter() - started
-
+    model, state, result, wall = timed_run(scene)
     body, surface = scene.bodies[0], scene.surfaces[0]
     a, load = body.shape.radius, -body.force[2]
     track = float(np.hypot(*body.position[:2]))
@@ -132,10 +118,7 @@ def write_page(r):
              f"| friction work, disc vs pin | {r['work_difference']:+.1e} |",
              f"| contact forces on the two parts, summed | {r['force_sum']:.1e} N |",
              "", "![the disc's track](../img/pin_on_worn_disc_track.png)", "", MARK_END]
-    text = PAGE.read_text()
-    section = "\n".join(lines)
-    text = text[:text.index(MARK_START)] + section + text[text.index(MARK_END) + len(MARK_END):]
-    PAGE.write_text(text)
+    replace_section(PAGE, MARK_START, MARK_END, "\n".join(lines))
 
 
 if __name__ == "__main__":

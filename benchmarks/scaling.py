@@ -7,7 +7,7 @@ P vertices pressed 1 µm into the counter-surface, and a far sheet 10 mm above
 it that brings the mesh to N vertices (the bulk of a CAD part that never
 touches). It frets ±2 µm at 20 Hz (dynamic mode), or slides at 0.1 m/s.
 Only the patch is in the active set, so the per-step cost should follow P,
-not N (DESIGN.md §6); against a mesh counter-surface each active vertex also
+not N (the targets of docs/performance.md); against a mesh counter-surface each active vertex also
 looks up the face under it.
 
 Then a 10⁴-vertex pin on a turning disc, analytic and mesh, against the same
@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
+from common import replace_section
 from meshwear import stepper
 from meshwear.model import build_model, initial_state
 from meshwear.scene import load_scene
@@ -329,14 +330,7 @@ def write_docs(rows, ref, size_ratio, top, box, fine, sliding, turning):
               "  shared 2-core machine that row was 1.36–1.50× (the contact kernel is compiled",
               "  for one per-vertex surface, as for one plane).",
               "", MARK_END]
-    perf = ROOT / "docs" / "performance.md"
-    text = perf.read_text()
-    section = "\n".join(lines)
-    if MARK_START in text:
-        text = text[:text.index(MARK_START)] + section + text[text.index(MARK_END) + len(MARK_END):]
-    else:
-        text = text.rstrip("\n") + "\n\n" + section + "\n"
-    perf.write_text(text)
+    replace_section(ROOT / "docs" / "performance.md", MARK_START, MARK_END, "\n".join(lines))
 
 
 if __name__ == "__main__":

@@ -28,6 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 import cases  # noqa: E402  (cap_depth)
 
+from common import replace_section  # noqa: E402
 from meshwear.scene import load_scene  # noqa: E402
 from meshwear.model import build_model, initial_state  # noqa: E402
 from meshwear.simulate import run  # noqa: E402
@@ -209,14 +210,7 @@ def main():
               f"{target['wall']:.1f} s; volume {target['volume_error']:+.2e} against k P s, max "
               f"depth {target['depth_error']:+.2e} against the cap")
     plot(rows)
-    perf = ROOT / "docs" / "performance.md"
-    text = perf.read_text()
-    section = markdown(rows, targets)
-    if MARK_START in text:
-        text = text[:text.index(MARK_START)] + section + text[text.index(MARK_END) + len(MARK_END):]
-    else:
-        text = text.rstrip("\n") + "\n\n" + section + "\n"
-    perf.write_text(text)
+    replace_section(ROOT / "docs" / "performance.md", MARK_START, MARK_END, markdown(rows, targets))
     print(json.dumps({"benchmark": "speed_vs_error", "seconds": time.perf_counter() - start,
                       "rows": rows, "targets": targets}))
 

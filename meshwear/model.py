@@ -187,8 +187,9 @@ class PartState:
         Their faces' frames (:func:`meshwear.kernels.nearest.face_frames`).
     depth, volume, work : (V,) float
         Wear depth (m), worn volume (m³) and friction work (J) per vertex.
-    added : (V,) float
-        Scratch of :func:`meshwear.kernels.counter_wear.wear_counter` (zeros).
+    added : (V,) float, touched : (V,) int64
+        Scratch of :func:`meshwear.kernels.counter_wear.wear_counter` (``added``
+        zeros between steps).
     """
 
     vertices: np.ndarray
@@ -197,13 +198,15 @@ class PartState:
     volume: np.ndarray
     work: np.ndarray
     added: np.ndarray
+    touched: np.ndarray
 
     @classmethod
     def unworn(cls, surface):
         n = len(surface.reference_vertices)
         return cls(vertices=surface.reference_vertices.copy(),
                    frames=face_frames(surface.reference_vertices, surface.faces),
-                   depth=np.zeros(n), volume=np.zeros(n), work=np.zeros(n), added=np.zeros(n))
+                   depth=np.zeros(n), volume=np.zeros(n), work=np.zeros(n), added=np.zeros(n),
+                   touched=np.zeros(n, np.int64))
 
 
 @dataclass(eq=False)

@@ -403,7 +403,7 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
     face frames are all recomputed. Returns the vertices that sank more than
     half their spacing."""
     (counter_law, faces, reference, normals, tributary, spacing, _, _, vertices, frames, depth,
-     volume, work, _) = part
+     volume, work, _, _) = part
     code, k = int(counter_law[0]), counter_law[1]
     f, dt, dt0, dt1 = law[0], law[4], law[11], law[12]
     R = quaternion_matrix(pose[3:7])

@@ -85,7 +85,7 @@ def test_kernel_matches_its_numpy_twin(tmp_path):
     assert wear_counter(*args, disc.part_tuple()) == -1
     twin_tuple = (disc.law, disc.faces, disc.reference_vertices, disc.vertex_normals,
                   disc.tributary, disc.spacing, None, None, twin.vertices, twin.frames,
-                  twin.depth, twin.volume, twin.work, twin.added)
+                  twin.depth, twin.volume, twin.work, twin.added, twin.touched)
     assert len(reference.wear_counter(*args, twin_tuple)) == 0
     assert (part.depth > depth0).sum() > 10
     for name in ("depth", "volume", "work", "vertices"):

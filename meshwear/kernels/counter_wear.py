@@ -26,7 +26,9 @@ part : tuple
     (V, 3), tributary areas (V,), local spacing (V,: the shortest edge at the
     vertex), the faces at each vertex (``starts`` (V + 1,) and ``items``
     int64), then what wear changes: vertices (V, 3), face frames (F, 4, 4),
-    wear depth, worn volume, friction work (V,) and scratch (V,).
+    wear depth, worn volume, friction work (V,), and scratch: the depth each
+    vertex took in the step (V,, zeros between steps) and the vertices that
+    took some (V,) int64.
 """
 
 import numpy as np
@@ -37,13 +39,13 @@ from .laws import wear_increment
 from .nearest import closest_on_triangle
 
 PART_FIELDS = ("law", "faces", "reference", "normals", "tributary", "spacing", "starts", "items",
-               "vertices", "frames", "depth", "volume", "work", "added")
+               "vertices", "frames", "depth", "volume", "work", "added", "touched")
 
 #: the part tuple of a surface that does not wear
 NO_PART = (np.array([-1.0, 0.0]), np.zeros((0, 3), np.int64), np.zeros((0, 3)), np.zeros((0, 3)),
            np.zeros(0), np.zeros(0), np.zeros(1, np.int64), np.zeros(0, np.int64),
            np.zeros((0, 3)), np.zeros((0, 4, 4)), np.zeros(0), np.zeros(0), np.zeros(0),
-           np.zeros(0))
+           np.zeros(0), np.zeros(0, np.int64))
 
 #: a counter vertex may sink by at most this fraction of its shortest edge in
 #: one step; deeper, its faces could fold over
@@ -51,27 +53,34 @@ SPACING_FRACTION = 0.5
 
 
 @njit(cache=True, inline="always")
+def _edge_line(frames, f, row, px, py, pz, qx, qy, qz, nx, ny, nz):
+    """Row ``row`` of face ``f``'s frame: the in-plane unit normal of edge
+    p -> q pointing out of the triangle, and its offset."""
+    ex, ey, ez = qx - px, qy - py, qz - pz
+    mx, my, mz = ey * nz - ez * ny, ez * nx - ex * nz, ex * ny - ey * nx
+    length = np.sqrt(mx * mx + my * my + mz * mz)
+    mx, my, mz = mx / length, my / length, mz / length
+    frames[f, row, 0], frames[f, row, 1], frames[f, row, 2] = mx, my, mz
+    frames[f, row, 3] = mx * px + my * py + mz * pz
+
+
+@njit(cache=True, inline="always")
 def _face_frame(vertices, faces, f, frames):
     """Frame of face ``f`` (:func:`meshwear.kernels.nearest.face_frames`), in place."""
     a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-    p = np.empty((3, 3))
-    for j in range(3):
-        p[0, j], p[1, j], p[2, j] = vertices[a, j], vertices[b, j], vertices[c, j]
-    ux, uy, uz = p[1, 0] - p[0, 0], p[1, 1] - p[0, 1], p[1, 2] - p[0, 2]
-    vx, vy, vz = p[2, 0] - p[0, 0], p[2, 1] - p[0, 1], p[2, 2] - p[0, 2]
+    ax, ay, az = vertices[a, 0], vertices[a, 1], vertices[a, 2]
+    bx, by, bz = vertices[b, 0], vertices[b, 1], vertices[b, 2]
+    cx, cy, cz = vertices[c, 0], vertices[c, 1], vertices[c, 2]
+    ux, uy, uz = bx - ax, by - ay, bz - az
+    vx, vy, vz = cx - ax, cy - ay, cz - az
     nx, ny, nz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
     length = np.sqrt(nx * nx + ny * ny + nz * nz)
     nx, ny, nz = nx / length, ny / length, nz / length
     frames[f, 0, 0], frames[f, 0, 1], frames[f, 0, 2] = nx, ny, nz
-    frames[f, 0, 3] = nx * p[0, 0] + ny * p[0, 1] + nz * p[0, 2]
-    for k in range(3):
-        q = (k + 1) % 3
-        ex, ey, ez = p[q, 0] - p[k, 0], p[q, 1] - p[k, 1], p[q, 2] - p[k, 2]
-        mx, my, mz = ey * nz - ez * ny, ez * nx - ex * nz, ex * ny - ey * nx
-        length = np.sqrt(mx * mx + my * my + mz * mz)
-        mx, my, mz = mx / length, my / length, mz / length
-        frames[f, k + 1, 0], frames[f, k + 1, 1], frames[f, k + 1, 2] = mx, my, mz
-        frames[f, k + 1, 3] = mx * p[k, 0] + my * p[k, 1] + mz * p[k, 2]
+    frames[f, 0, 3] = nx * ax + ny * ay + nz * az
+    _edge_line(frames, f, 1, ax, ay, az, bx, by, bz, nx, ny, nz)
+    _edge_line(frames, f, 2, bx, by, bz, cx, cy, cz, nx, ny, nz)
+    _edge_line(frames, f, 3, cx, cy, cz, ax, ay, az, nx, ny, nz)
 
 
 @njit(cache=True)
@@ -83,7 +92,7 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
     :data:`SPACING_FRACTION` of its spacing in this step (the step is done
     all the same: the caller stops the run)."""
     (counter_law, faces, reference, normals, tributary, spacing, starts, items, vertices, frames,
-     depth, volume, work, added) = part
+     depth, volume, work, added, touched) = part
     code, k_counter = int(counter_law[0]), counter_law[1]
     f, dt = law[0], law[4]
     dt0, dt1 = law[11], law[12]
@@ -91,7 +100,6 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
     cx, cy, cz = pose[0], pose[1], pose[2]
     vx, vy, vz = pose[7], pose[8], pose[9]
     wx, wy, wz = pose[10], pose[11], pose[12]
-    touched = np.empty(3 * active.shape[0], np.int64)
     count = 0
     for slot in range(active.shape[0]):
         i = active[slot]

@@ -34,8 +34,8 @@ def body_quantities(body, s, model):
     Returns
     -------
     dict
-        ``points`` (n, 3) world positions, the point-data fields of DESIGN.md
-        §5 and the history totals.
+        ``points`` (n, 3) world positions, the point-data fields of
+        docs/outputs.md and the history totals.
     """
     R = np.array(rotation_entries(s.pose[3:7])).reshape(3, 3)
     normal_force = s.normal_force.sum(axis=0)
@@ -63,23 +63,12 @@ def body_quantities(body, s, model):
 
 
 def _matrix_quaternion(R):
-    """Unit quaternion (w, x, y, z), w >= 0, of a rotation matrix (Shepperd's method)."""
-    trace = R[0, 0] + R[1, 1] + R[2, 2]
-    k = int(np.argmax([trace, R[0, 0], R[1, 1], R[2, 2]]))
-    if k == 0:
-        w = 0.5 * np.sqrt(1.0 + trace)
-        q = [w, (R[2, 1] - R[1, 2]) / (4 * w), (R[0, 2] - R[2, 0]) / (4 * w),
-             (R[1, 0] - R[0, 1]) / (4 * w)]
-    else:
-        i, j, m = k - 1, k % 3, (k + 1) % 3
-        r = 0.5 * np.sqrt(1.0 + R[i, i] - R[j, j] - R[m, m])
-        q = [0.0, 0.0, 0.0, 0.0]
-        q[0] = (R[m, j] - R[j, m]) / (4 * r)
-        q[1 + i] = r
-        q[1 + j] = (R[j, i] + R[i, j]) / (4 * r)
-        q[1 + m] = (R[m, i] + R[i, m]) / (4 * r)
-    q = np.array(q)
-    return q if q[0] >= 0.0 else -q
+    """Unit quaternion (w, x, y, z), w >= 0, of a rotation matrix."""
+    from scipy.spatial.transform import Rotation
+
+    x, y, z, w = Rotation.from_matrix(R).as_quat()
+    q = np.array([w, x, y, z])
+    return q if w >= 0.0 else -q
 
 
 def part_quantities(model, state, m):

@@ -99,8 +99,11 @@ class SurfaceSet:
         """The per-vertex surfaces' tuples as the numba typed list the
         compiled loop takes (rebuilt when one changed: a face grid rebinned)."""
         tuples = [s.compiled() for s in self.per_vertex]
-        ids = [id(t) for t in tuples]
-        if getattr(self, "_list_ids", None) != ids:
+        # the tuples themselves are kept (not their ids: a freed tuple's id
+        # can come back for the next one, a worn surface attached anew)
+        held = getattr(self, "_list_tuples", None)
+        if held is None or len(held) != len(tuples) or any(
+                a is not b for a, b in zip(held, tuples)):
             # built by cached compiled functions: a typed list built from
             # Python compiles its methods anew in every process (1 s here)
             if tuples:
@@ -109,7 +112,7 @@ class SurfaceSet:
                     _append(self._list, t)
             else:
                 self._list = _empty_list_of(_sample_tuple())
-            self._list_ids = ids
+            self._list_tuples = tuples
         return self._list
 
     def set_planes(self, t):

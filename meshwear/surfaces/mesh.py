@@ -162,7 +162,8 @@ class MeshSurface(CounterSurface):
         part = self.part
         return (self.law, self.faces, self.reference_vertices, self.vertex_normals,
                 self.tributary, self.spacing, self.vertex_face_starts, self.vertex_face_items,
-                part.vertices, part.frames, part.depth, part.volume, part.work, part.added)
+                part.vertices, part.frames, part.depth, part.volume, part.work, part.added,
+                part.touched)
 
     # ------------------------------------------------------------ the interface
     def ensure_reach(self, reach):

@@ -1,0 +1,36 @@
+"""What the benchmarks share: a run timed as ``meshwear run`` takes it, and
+the generated section of a docs page."""
+
+import tempfile
+import time
+
+from meshwear.model import build_model, check_time_step, initial_state
+from meshwear.output.recorder import RunRecorder, summary
+from meshwear.simulate import run
+
+
+def timed_run(scene):
+    """Build, run and write the outputs of ``scene`` (into a temporary
+    folder), as ``meshwear run`` does; return the model, the final state,
+    its ``summary.json`` object and the wall time (s)."""
+    start = time.perf_counter()
+    model = build_model(scene)
+    check_time_step(model)
+    state = initial_state(model)
+    with tempfile.TemporaryDirectory() as out:
+        recorder = RunRecorder(out, model)
+        run(model, state, observers=[recorder])
+        result = summary(model, state, time.perf_counter() - start)
+        recorder.close(result)
+    return model, state, result, time.perf_counter() - start
+
+
+def replace_section(page, start, end, section):
+    """Put ``section`` (text from the ``start`` marker to the ``end`` one)
+    in place of the page's, or append it if the page has none."""
+    text = page.read_text()
+    if start in text:
+        text = text[:text.index(start)] + section + text[text.index(end) + len(end):]
+    else:
+        text = text.rstrip("\n") + "\n\n" + section + "\n"
+    page.write_text(text)
