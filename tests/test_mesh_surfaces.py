@@ -95,6 +95,24 @@ def test_nearest_planes_match_brute_force_twin(smooth):
                              reach, fixed_twin, twin_distance, fixed_twin_hint)
     assert _close(fixed_out, fixed_twin) and _close(distance, twin_distance)
     assert (fixed_hint == fixed_twin_hint).all()
+    # the surface does not move either (steady): a vertex that keeps its flat
+    # face keeps the point of the plane it holds, no longer its foot; the
+    # same plane, and the velocity at the foot
+    steady_out, steady_hint = fixed_out.copy(), fixed_hint.copy()
+    moved[0:3] += [2e-4, 1e-4, -1e-4]
+    nearest.nearest_planes(body, moved, active, rotation, motion, V, F, frames, vnormals, *grid,
+                           steady_out, distance, steady_hint, True, True)
+    reference.nearest_planes(body, moved, active, rotation, motion, V, F, normals, vnormals,
+                             reach, fixed_twin, twin_distance, fixed_twin_hint)
+    assert _close(distance, twin_distance) and (steady_hint == fixed_twin_hint).all()
+    assert _close(steady_out[:, 1], fixed_twin[:, 1])
+    n_ = fixed_twin[:, 1]
+    assert _close(np.einsum("ij,ij->i", steady_out[:, 0], n_),
+                  np.einsum("ij,ij->i", fixed_twin[:, 0], n_))
+    assert _close(steady_out[:, 2], fixed_twin[:, 2])
+    kept = np.isfinite(distance) & (steady_hint >= 0)
+    moved_foot = np.linalg.norm(steady_out[kept, 0] - fixed_twin[kept, 0], axis=1) > 1e-5
+    assert moved_foot.any() != smooth, "flat faces keep their plane; smooth ones are rewritten"
     # and, a third of them starting from a wrong face, without that promise
     pose[0:3] += [3e-4, -2e-4, 1e-4]
     stale = rng.random(n) < 0.3

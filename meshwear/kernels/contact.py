@@ -23,8 +23,9 @@ planes : (P, 4, 3)
     a vertex is ``v + omega x (a - point)``, ``a`` the vertex's foot.
 vertex_planes : (M, n, 3, 3)
     Per mesh counter-surface and vertex, the same for the plane of the
-    counter face under the vertex, the velocity being the counter-surface's at
-    that point (:mod:`meshwear.kernels.nearest` fills it); a zero normal means
+    counter face under the vertex (a point of it, not necessarily the
+    vertex's foot), the velocity being the counter-surface's at the vertex's
+    foot (:mod:`meshwear.kernels.nearest` fills it); a zero normal means
     no face within reach. Pair slot ``P + m``.
 active : (k,) int64
     Indices of the vertices to process (the active set), each in

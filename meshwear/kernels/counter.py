@@ -57,14 +57,19 @@ def fill_planes(surface, t, body_vertices, pose, active, out, distance, hint, bu
         # its faces stay put in its frame: the frame turns only for a
         # turning surface that is not frozen, and wear moves faces
         fixed = (frozen or motion[15] == 0.0) and part[0][0] < 0.0
+        # and its frame stays where it was: no path (zero rows add nothing)
+        steady = fixed
+        for m in range(terms.shape[0]):
+            for j in range(1, 9):
+                steady = steady and terms[m, j] == 0.0
         if threads:
             nearest_planes_parallel(body_vertices, pose, active, rotation, frame,
                                     counter_vertices, faces, frames, corner_normals, grid, keys,
-                                    starts, items, out, distance, hint, fixed)
+                                    starts, items, out, distance, hint, fixed, steady)
         else:
             nearest_planes_serial(body_vertices, pose, active, rotation, frame, counter_vertices,
                                   faces, frames, corner_normals, grid, keys, starts, items, out,
-                                  distance, hint, fixed)
+                                  distance, hint, fixed, steady)
     elif kind == CYLINDER:
         if threads:
             cylinder_planes_parallel(body_vertices, pose, active, rotation, frame, geometry, out,

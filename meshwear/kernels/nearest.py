@@ -35,7 +35,7 @@ import numpy as np
 from numba import njit, prange
 
 from .contact import _named_copy, rotation_entries  # noqa: F401  (re-exported for twins)
-from .frames import offset, to_frame
+from .frames import to_frame
 
 #: relative tolerance under which two faces count as equally near (a point
 #: beyond a shared edge or vertex); the one whose plane separates more wins
@@ -136,7 +136,7 @@ def _along(frames, f, row, x, y, z):
 
 def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
                     frames, corner_normals, grid, keys, starts, items, out, distance, hint,
-                    fixed):
+                    fixed, steady):
     r = rotation_entries(pose[3:7])
     smooth = corner_normals.shape[0] > 0
     flat = not smooth
@@ -149,12 +149,24 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
     v0, v1, v2 = motion[1, 0], motion[1, 1], motion[1, 2]
     w0, w1, w2 = motion[2, 0], motion[2, 1], motion[2, 2]
     c0, c1, c2 = motion[3, 0], motion[3, 1], motion[3, 2]
+    # and the body's position and the frame's rotation (frames.offset and
+    # frames.to_frame, inlined on scalars: read from the arrays, they would be
+    # read again for every vertex, after each write to out)
+    p0, p1, p2 = pose[0], pose[1], pose[2]
+    q00, q01, q02 = rotation[0, 0], rotation[0, 1], rotation[0, 2]
+    q10, q11, q12 = rotation[1, 0], rotation[1, 1], rotation[1, 2]
+    q20, q21, q22 = rotation[2, 0], rotation[2, 1], rotation[2, 2]
     for k in prange(active.shape[0]):
         # unsigned, so that indexing skips numpy's negative-index wrap-around
         i = np.uint64(active[k])
         # world position, then counter frame: y = Rc^T (x - origin)
-        ex, ey, ez = offset(r, pose, body_vertices, i, motion)
-        yx, yy, yz = to_frame(rotation, ex, ey, ez)
+        bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
+        ex = p0 + r[0] * bx + r[1] * by + r[2] * bz - o0
+        ey = p1 + r[3] * bx + r[4] * by + r[5] * bz - o1
+        ez = p2 + r[6] * bx + r[7] * by + r[8] * bz - o2
+        yx = q00 * ex + q10 * ey + q20 * ez
+        yy = q01 * ex + q11 * ey + q21 * ez
+        yz = q02 * ex + q12 * ey + q22 * ez
         # the normal it was given last step (world), zero if none: a vertex
         # keeps to the faces it came from (TRACKING)
         ox, oy, oz = out[i, 1, 0], out[i, 1, 1], out[i, 1, 2]
@@ -239,6 +251,17 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             continue
         # over its face, a vertex's distance to it is its distance to the plane
         distance[i] = abs(best_delta) if by_hint else np.sqrt(best_d2)
+        if by_hint and steady and fixed and flat:
+            # the same face of a surface that stays where it is: the plane it
+            # holds (point, normal) is still right; the velocity is the one at
+            # the vertex's foot, which moves with the body
+            lx = ex + o0 - best_delta * ox - c0
+            ly = ey + o1 - best_delta * oy - c1
+            lz = ez + o2 - best_delta * oz - c2
+            out[i, 2, 0] = v0 + w1 * lz - w2 * ly
+            out[i, 2, 1] = v1 + w2 * lx - w0 * lz
+            out[i, 2, 2] = v2 + w0 * ly - w1 * lx
+            continue
         hx, hy, hz = frames[best, 0, 0], frames[best, 0, 1], frames[best, 0, 2]
         if smooth:
             # the normal interpolated at the closest point of the face
@@ -312,10 +335,11 @@ PARALLEL_THRESHOLD = 2048
 
 def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
                    frames, corner_normals, grid, keys, starts, items, out, distance, hint,
-                   fixed=False):
+                   fixed=False, steady=False):
     """For each ``active`` vertex ``i`` of a body at ``pose``, write to
     ``out[i]`` (3, 3) the plane of its nearest counter face within the grid's
-    reach (``grid[7]``) (point, normal, counter velocity there; world), to
+    reach (``grid[7]``) (a point of it, its normal, and the counter velocity at
+    the vertex's foot on it; world), to
     ``distance[i]`` the distance to that face and to ``hint[i]`` (int64) the
     face's index; zeros, ``inf`` and -1 where no face qualifies. A vertex that
     had a plane (``out[i]`` nonzero on entry) keeps to faces whose normal is
@@ -324,11 +348,15 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
     unless it is :data:`RELEASE` times deeper under it than near another face.
     ``fixed``: the surface's ``rotation`` is the one of the call that filled
     ``out`` (a fixed or frozen surface), so a vertex that keeps its face
-    keeps the normal it holds."""
+    keeps the normal it holds. ``steady``: such a surface that does not move
+    either (no path; a steady turn frozen out of its frame is allowed): a
+    vertex that keeps its flat face keeps the point of the plane it holds
+    (no longer its foot); only its velocity, at the foot, is written."""
     kernel = (nearest_planes_parallel if active.shape[0] >= PARALLEL_THRESHOLD
               else nearest_planes_serial)
     kernel(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-           frames, corner_normals, grid, keys, starts, items, out, distance, hint, fixed)
+           frames, corner_normals, grid, keys, starts, items, out, distance, hint, fixed,
+           steady)
 
 
 #: faces meeting at a vertex at more than 60 degrees are a crease: smoothed

@@ -119,7 +119,7 @@ class MeshSurface(CounterSurface):
             out, distance = np.zeros((n, 3, 3)), np.full(n, np.inf)
             kernel(turned, identity, active, np.eye(3), np.zeros((4, 3)), self.vertices,
                    self.faces, self.frames, self.corner_normals, grid, keys, starts, items, out,
-                   distance, np.full(n, -1), True)
+                   distance, np.full(n, -1), True, False)
             worst = max(worst, float(distance.max()))
             if not worst <= limit:
                 return np.inf
