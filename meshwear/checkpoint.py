@@ -67,6 +67,10 @@ def save(path, model, state, wall_time):
         for k, alpha in enumerate(js.alpha):
             if alpha is not None:
                 arrays[f"jump{k}_alpha"] = alpha
+        for k, (rate, error) in enumerate(zip(js.part_rate, js.part_error)):
+            arrays[f"jump_part{k}_error"] = error
+            if rate is not None:
+                arrays[f"jump_part{k}_rate"] = rate
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
@@ -123,6 +127,7 @@ def load(path, model, state):
             if part is not None:
                 for name in _PART_ARRAYS:
                     getattr(part, name)[...] = data[f"part{m}_{name}"]
+                model.surfaces.per_vertex[m].rebin()
     except (KeyError, ValueError) as err:
         raise SceneError(model.scene.source, "", f"{path} was written by another version of "
                          f"meshwear ({err}); run without --resume to start again") from None
@@ -133,12 +138,16 @@ def load(path, model, state):
             key, value = str(item).split("=")
             limits[key] = int(value)
         n = len(state.bodies)
+        worn = [p for p in state.parts if p is not None]
         state.jump = JumpState(
             rate=[data[f"jump{k}_rate"].copy() if f"jump{k}_rate" in data else None
                   for k in range(n)],
             error=[data[f"jump{k}_error"].copy() for k in range(n)],
             alpha=[data[f"jump{k}_alpha"].copy() if f"jump{k}_alpha" in data else None
                    for k in range(n)],
+            part_rate=[data[f"jump_part{k}_rate"].copy() if f"jump_part{k}_rate" in data
+                       else None for k in range(len(worn))],
+            part_error=[data[f"jump_part{k}_error"].copy() for k in range(len(worn))],
             gap=float(gap), last_jump=int(last), jumps=int(jumps), resolved_steps=int(resolved),
             settling=bool(settling), limits=limits)
     return float(wall)

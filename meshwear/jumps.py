@@ -17,6 +17,12 @@ gear flank) wears ``J alpha_i pbar_i / (1 + J alpha_i)``: bounded by its
 penetration, whatever ``J``. A vertex out of contact that the move brings in
 wears as the contact does on average per unit penetration.
 
+A worn counter-part relieves a vertex too: the counter's wear under it in
+the cycle, ``r_c,i = gamma_i pbar_i`` (linear in the pressure alike), adds to
+the relief, ``(p_i - beta_i z) / (1 + J (alpha_i + gamma_i))``, while the
+vertex itself wears ``J alpha_i`` times that (:func:`counter_relief`; the
+counter-part's own wear is extrapolated in :mod:`meshwear.wear`).
+
 A jump is taken as two steps of ``J / 2`` (the second from the penetrations
 the first leaves); the same jump as one step of ``J`` differs from it by
 about its error (step doubling).
@@ -92,6 +98,9 @@ class BodyJump:
     load: float              # load the contacts carry along the free axis (N)
     guided: bool
     rest: float = 0.0        # the balance without a jump (m): moves are from it
+    gamma: np.ndarray = None  # (k,) worn counter-parts' wear under it per cycle per unit
+                              # mean penetration (1 / cycle), or None
+    counter: np.ndarray = None  # (k,) that wear per cycle (m), or None
 
 
 def measure(model, body, s, rate, steps):
@@ -128,18 +137,22 @@ def measure(model, body, s, rate, steps):
 
 def _step(m, jump, depth, mean):
     """One backward-Euler step of ``jump`` cycles from penetrations ``depth``
-    (balance members) and ``mean`` (touched only): (n,) wear and the move z."""
-    relief = 1.0 / (1.0 + jump * m.alpha)
+    (balance members) and ``mean`` (touched only): (n,) wear, the move z and
+    (n,) the penetration the step takes off (its own and the counter-parts'
+    wear)."""
+    rate = m.alpha if m.gamma is None else m.alpha + m.gamma
+    relief = 1.0 / (1.0 + jump * rate)
     z = 0.0
     if m.guided:
         k = m.member
         z = balance(depth[k], m.beta[k], m.stiffness[k] * relief[k], m.load)
-    wear = np.zeros(len(depth))
+    # the penetration the step leaves (relieved), for members and touched ones
+    left = np.zeros(len(depth))
     k = m.member
-    wear[k] = jump * m.alpha[k] * np.maximum(0.0, depth[k] - m.beta[k] * z) * relief[k]
+    left[k] = np.maximum(0.0, depth[k] - m.beta[k] * z) * relief[k]
     t = m.touched
-    wear[t] = jump * m.alpha[t] * mean[t] * relief[t]
-    return wear, z
+    left[t] = mean[t] * relief[t]
+    return jump * m.alpha * left, z, jump * rate * left
 
 
 def implicit(m, jump):
@@ -150,8 +163,50 @@ def implicit(m, jump):
     differs from it by about its error (first order: the one step's error is
     twice the two's), as in embedded Runge-Kutta pairs that advance with the
     better of the two."""
-    whole, _ = _step(m, jump, m.depth, m.mean)
-    half, z1 = _step(m, 0.5 * jump, m.depth, m.mean)
-    rest, z2 = _step(m, 0.5 * jump, m.depth - m.beta * z1 - half, np.maximum(0.0, m.mean - half))
+    whole, _, _ = _step(m, jump, m.depth, m.mean)
+    half, z1, taken = _step(m, 0.5 * jump, m.depth, m.mean)
+    rest, z2, _ = _step(m, 0.5 * jump, m.depth - m.beta * z1 - taken,
+                        np.maximum(0.0, m.mean - taken))
     wear = half + rest
     return wear, z1 + z2 - m.rest, np.abs(whole - wear)
+
+
+def counter_relief(model, s, m, increments, t):
+    """Set ``m.gamma`` and ``m.counter`` of body measure ``m``: per vertex,
+    the wear the worn counter-parts took under it in the cycle (``increments``:
+    per per-vertex surface, its (V,) depth increment, or None), interpolated
+    at the vertex's foot on the face it is over at ``t`` (the end of the
+    cycle), and that per unit mean penetration."""
+    counter = np.zeros(len(m.index))
+    R = quaternion_matrix(s.pose[3:7])
+    for j, (surface, increment) in enumerate(zip(model.surfaces.per_vertex, increments)):
+        if increment is None:
+            continue
+        face = s.hint[j][m.index]
+        on = face >= 0
+        if not on.any():
+            continue
+        planes = s.vertex_planes[j][m.index[on]]
+        x = s.pose[0:3] + s.vertices[m.index[on]] @ R.T
+        normal = planes[:, 1]
+        foot = x - np.einsum("ij,ij->i", x - planes[:, 0], normal)[:, None] * normal
+        rotation, frame = surface.frame(t)
+        local = (foot - frame[0]) @ rotation
+        corners = surface.faces[face[on]]
+        weights = barycentric(local, surface.vertices[corners])
+        counter[on] += np.einsum("ij,ij->i", weights, increment[corners])
+    m.counter = counter
+    m.gamma = np.where(m.mean > 0.0, counter / np.where(m.mean > 0.0, m.mean, 1.0), 0.0)
+
+
+def barycentric(points, triangles):
+    """(k, 3) barycentric weights of ``points`` (k, 3) projected on
+    ``triangles`` (k, 3, 3), clipped to the triangle (non-negative, summing to 1)."""
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    n = np.cross(b - a, c - a)
+    area2 = np.einsum("ij,ij->i", n, n)
+    u = np.einsum("ij,ij->i", np.cross(c - b, points - b), n) / area2
+    v = np.einsum("ij,ij->i", np.cross(a - c, points - c), n) / area2
+    w = 1.0 - u - v
+    weights = np.maximum(np.stack([u, v, w], axis=1), 0.0)
+    return weights / weights.sum(axis=1)[:, None]

@@ -244,10 +244,10 @@ def build_model(scene):
             raise SceneError(scene.source, key, str(err)) from None
     for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
         if getattr(s, "wear", False):
-            if scene.wear.acceleration == "cycle_jump":
+            if scene.wear.acceleration == "cycle_jump" and scene.wear.jump == "explicit":
                 raise SceneError(scene.source, f"surface[{j}].wear",
-                                 "a worn counter-surface cannot be cycle-jumped yet; run it "
-                                 "resolved (wear.acceleration = 'none')")
+                                 "a worn counter-surface is cycle-jumped by implicit jumps "
+                                 "only; set wear.jump = 'implicit' (the default)")
             surface.make_worn(code_of(s.law or scene.wear.law),
                               scene.wear.coefficient if s.coefficient is None else s.coefficient)
     surface_set = surfaces.SurfaceSet(built)

@@ -20,6 +20,14 @@ explicit
     extrapolated wear opens a gap where the contact carried load, and the worn
     profile oscillates from jump to jump while the worn volume looks right).
 
+A worn counter-part (docs/model.md, "Worn counter-surfaces") jumps with
+the bodies: its wear in the resolved cycle relieves the body vertices over it
+in the implicit step (:func:`meshwear.jumps.counter_relief`) and is itself
+extrapolated over the ``J`` cycles, ``J`` bounded by its slope criterion (as
+an explicit jump), by :data:`THETA` of the penetration of the body vertices
+over it, and by a fraction of its mesh spacing
+(:data:`meshwear.kernels.counter_wear.SPACING_FRACTION`) per jump.
+
 Either way ``J`` grows by at most a factor :data:`GROWTH` from one jump to
 the next, the errors of all jumps add up to at most ``tolerance`` times the
 deepest wear (the summary's ``error_estimate``), and the run ends with a
@@ -35,6 +43,8 @@ import numpy as np
 
 from . import jumps
 from .kernels.contact import ANCHOR
+from .kernels.counter_wear import SPACING_FRACTION
+from .kernels.nearest import face_frames
 from .output import filled
 from .surfaces import contact_areas, quaternion_matrix, slot_normals
 
@@ -61,6 +71,10 @@ class JumpState:
     alpha: list = field(default_factory=list)      # per body (n,) implicit: wear per cycle per
                                                     # unit penetration, last measured (0: none)
     limits: dict = field(default_factory=lambda: {"accuracy": 0, "growth": 0, "end": 0})
+    part_rate: list = field(default_factory=list)  # per worn counter-part (V,) wear per
+                                                    # cycle, last measured (or None)
+    part_error: list = field(default_factory=list)  # per worn counter-part (V,) estimated
+                                                     # error of its depth (m)
 
 
 def penetration(model, body, s):
@@ -126,10 +140,13 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
     n_c = model.cycle_steps
     tolerance = model.scene.wear.tolerance
     implicit = model.scene.wear.jump == "implicit"
+    parts = [(j, part) for j, part in enumerate(state.parts) if part is not None]
     if state.jump is None:
         state.jump = JumpState(rate=[None] * len(model.bodies),
                                error=[np.zeros(len(b.tributary_area)) for b in model.bodies],
-                               alpha=[None] * len(model.bodies))
+                               alpha=[None] * len(model.bodies),
+                               part_rate=[None] * len(parts),
+                               part_error=[np.zeros(len(p.depth)) for _, p in parts])
     js = state.jump
     for body, s in zip(model.bodies, state.bodies):
         if len(s.load) != len(s.wear_depth):
@@ -138,6 +155,7 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
         start = state.step
         before = [(s.wear_depth.copy(), s.vertices.copy(), s.wear_volume.copy(),
                    s.friction_work.copy()) for s in state.bodies]
+        before_parts = [(p.depth.copy(), p.volume.copy(), p.work.copy()) for _, p in parts]
         for s in state.bodies:
             s.load[:] = 0.0
         stop = min(start + n_c, model.n_steps)
@@ -155,12 +173,26 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
             js.settling = False
             continue
         rates = [s.wear_depth - b[0] for s, b in zip(state.bodies, before)]
+        part_rates = [p.depth - b[0] for (_, p), b in zip(parts, before_parts)]
         measures = ([jumps.measure(model, body, s, rate, stop - start)
                      for body, s, rate in zip(model.bodies, state.bodies, rates)]
                     if implicit else None)
+        part_limit, part_which = float("inf"), None
+        if parts:
+            increments = [None] * len(state.parts)
+            for (j, _), rate in zip(parts, part_rates):
+                increments[j] = rate
+            for s, m in zip(state.bodies, measures):
+                jumps.counter_relief(model, s, m, increments, state.time)
+            if forced_jump is None:
+                part_limit, part_which = _part_limit(model, parts, part_rates, js, measures,
+                                                     tolerance, end_limit)
         if implicit:
-            jump, which, results = _choose_implicit(measures, rates, js, end_limit, could,
-                                                    tolerance, forced_jump)
+            jump, which, results = _choose_implicit(measures, rates, js, end_limit,
+                                                    int(min(could, part_limit)), tolerance,
+                                                    forced_jump)
+            if part_limit < could and which == "growth":
+                which = part_which
         else:
             jump, which = end_limit, "end"
             if forced_jump is not None:
@@ -179,11 +211,13 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
                 error += estimate
             js.limits[which] = js.limits.get(which, 0) + 1
             spans = _jump(model, state, before, rates, jump, results, measures)
-            filled.write(model, state, stop, jump, snapshots, spans, observers)
+            part_spans = _jump_parts(model, parts, before_parts, part_rates, js, jump)
+            filled.write(model, state, stop, jump, snapshots, spans, observers, part_spans)
             js.jumps += 1
             js.settling = not model.quasi_static
         js.last_jump = jump
         js.rate = rates
+        js.part_rate = part_rates
         if implicit:
             js.alpha = []
             for m, rate in zip(measures, rates):
@@ -313,6 +347,79 @@ def _jump(model, state, before, rates, jump, results, measures=None):
     return spans
 
 
+def _part_limit(model, parts, part_rates, js, measures, tolerance, end):
+    """The most cycles the worn counter-parts allow a jump, and the bound
+    that sets it: their slope criterion (as an explicit jump's), the
+    counter's wear under each body vertex within :data:`THETA` of its
+    penetration (the counter is extrapolated, not relieved), and a part
+    vertex sinking by at most SPACING_FRACTION of its spacing per jump."""
+    bounds = {}
+    for (j, part), rate, previous in zip(parts, part_rates, js.part_rate):
+        if rate.max(initial=0.0) <= 0.0:
+            continue
+        if previous is None:
+            return 0, "counter accuracy"
+        # a counter vertex's wear in one cycle is sampled by the steps of the
+        # passes over it, and differs from cycle to cycle by that sampling
+        # (a pass over a track's edge takes a few steps); a jump multiplies
+        # one cycle's, so it is taken only where that noise, estimated by
+        # the last two measurements, stays within the tolerance
+        if _noise(rate, previous) > tolerance * rate.max():
+            return 0, "counter noise"
+        jump, which = choose_jump(rate, previous, js.gap, np.zeros(len(rate)), tolerance,
+                                  js.last_jump, end, stability=False)
+        key = "counter accuracy" if which == "accuracy" else which
+        bounds[key] = min(bounds.get(key, np.inf), float(jump))
+        spacing = model.surfaces.per_vertex[j].spacing
+        sinking = rate > 0.0
+        bounds["counter spacing"] = min(bounds.get("counter spacing", np.inf), float(
+            (SPACING_FRACTION * spacing[sinking] / rate[sinking]).min()))
+    for m in measures:
+        pressed = (m.counter > 0.0) & (m.depth > 0.0) & m.member
+        if pressed.any():
+            bounds["counter stability"] = min(bounds.get("counter stability", np.inf), float(
+                (THETA * m.depth[pressed] / m.counter[pressed]).min()))
+    if not bounds:
+        return float("inf"), None
+    which = min(bounds, key=bounds.get)
+    return max(0, int(np.floor(bounds[which]))), which
+
+
+def _jump_parts(model, parts, before_parts, part_rates, js, jump):
+    """Extrapolate each worn counter-part's wear in the last resolved cycle
+    over ``jump`` more cycles (its vertices moved to their new depth, their
+    faces' frames and the face grid renewed); return per part ``{name:
+    (array at the jump's start, at its end)}`` for depth, volume, work and
+    vertices."""
+    spans = []
+    for k, ((j, part), (_, volume0, work0), rate) in enumerate(
+            zip(parts, before_parts, part_rates)):
+        surface = model.surfaces.per_vertex[j]
+        span = {name: getattr(part, name).copy() for name in PART_JUMPED}
+        part.depth += jump * rate
+        part.volume += jump * (part.volume - volume0)
+        part.work += jump * (part.work - work0)
+        part.vertices[:] = surface.reference_vertices - part.depth[:, None] * surface.vertex_normals
+        part.frames[:] = face_frames(part.vertices, surface.faces)
+        surface.rebin()
+        previous = js.part_rate[k]
+        js.part_error[k] += _slope_error(rate, previous, js.gap, jump)
+        if previous is not None:
+            js.part_error[k] += jump * _noise(rate, previous)
+        spans.append({name: (span[name], getattr(part, name).copy()) for name in PART_JUMPED})
+    return spans
+
+
+def _noise(rate, previous):
+    """Half the largest change of a counter vertex's wear per cycle between
+    two measurements: the sampling noise of one cycle's wear, at most."""
+    return 0.5 * float(np.abs(rate - previous).max())
+
+
+#: the arrays of a worn counter-part a jump extrapolates
+PART_JUMPED = ("depth", "volume", "work", "vertices")
+
+
 def _wear_fresh(body, s, fresh, wear, normal, work_per_volume):
     """Wear ``wear[fresh]`` of vertices with no cycle increments to scale,
     pressed by the surfaces of world ``normal`` (n, 3)."""
@@ -333,8 +440,9 @@ def error_estimate(state):
     if js is None:
         return 0.0
     worst = 0.0
-    for error, s in zip(js.error, state.bodies):
-        deepest = s.wear_depth.max() if len(s.wear_depth) else 0.0
+    worn = [p.depth for p in state.parts if p is not None]
+    for error, depth in zip(js.error + js.part_error, [s.wear_depth for s in state.bodies] + worn):
+        deepest = depth.max() if len(depth) else 0.0
         if deepest > 0.0:
             worst = max(worst, float(error.max() / deepest))
     return worst

@@ -26,7 +26,7 @@ PIN_ON_WORN_DISC = """format = 1
 [run]
 mode = "quasi-static"
 duration = {duration}
-dt = 2e-3
+dt = {dt}
 frames = 3
 history = 5
 [contact]
@@ -59,9 +59,10 @@ P, A, R, OMEGA, K_PIN, K_DISC = 10.0, 1e-3, 5e-3, 10.0, 1e-13, 2e-13
 TWO_TURNS = 4.0 * np.pi / OMEGA
 
 
-def _scene(tmp_path, duration=TWO_TURNS, coefficient=K_DISC, extra=""):
+def _scene(tmp_path, duration=TWO_TURNS, coefficient=K_DISC, extra="", dt=2e-3):
     path = tmp_path / "pin_on_worn_disc.toml"
-    path.write_text(PIN_ON_WORN_DISC.format(duration=duration, coefficient=coefficient) + extra)
+    path.write_text(PIN_ON_WORN_DISC.format(duration=duration, coefficient=coefficient, dt=dt)
+                    + extra)
     return path
 
 
@@ -204,12 +205,79 @@ def test_a_law_without_wear_is_refused(tmp_path):
         load_scene(path)
 
 
-def test_cycle_jumps_over_a_worn_surface_are_refused(tmp_path):
-    path = _scene(tmp_path)
-    path.write_text(path.read_text().replace('law = "archard"',
-                                             'law = "archard"\nacceleration = "cycle_jump"'))
-    with pytest.raises(SceneError, match="surface\\[0\\].wear.*cannot be cycle-jumped"):
-        build_model(load_scene(path))
+#: the step of the jumped runs: a disc vertex near the track's edge passes
+#: under the pin in a few steps of 2 ms, and the wear one cycle deposits on it
+#: varies by some percent with how the steps fall (a jump multiplies one
+#: cycle's); in steps of 0.5 ms it stays within the tolerance
+JUMPED_DT = 5e-4
+
+
+def _jumped(tmp_path, turns, jump="implicit"):
+    """The pin on the worn disc over ``turns`` turns, cycle-jumped."""
+    path = _scene(tmp_path, duration=turns * 2.0 * np.pi / OMEGA, dt=JUMPED_DT)
+    path.write_text(path.read_text().replace(
+        'law = "archard"', f'law = "archard"\nacceleration = "cycle_jump"\njump = "{jump}"'))
+    return path
+
+
+def test_explicit_jumps_over_a_worn_surface_are_refused(tmp_path):
+    with pytest.raises(SceneError, match="surface\\[0\\].wear.*implicit jumps only"):
+        build_model(load_scene(_jumped(tmp_path, 10, "explicit")))
+
+
+@pytest.fixture(scope="module")
+def ten_turns(tmp_path_factory):
+    """The pin on the worn disc over ten turns, resolved and cycle-jumped."""
+    folder = tmp_path_factory.mktemp("ten")
+    resolved = build_model(load_scene(_scene(folder, duration=10 * 2.0 * np.pi / OMEGA,
+                                             dt=JUMPED_DT)))
+    jumped = build_model(load_scene(_jumped(folder, 10)))
+    return (resolved, run(resolved, initial_state(resolved)),
+            jumped, run(jumped, initial_state(jumped)))
+
+
+def test_cycle_jumps_carry_both_parts_wear(ten_turns, measured):
+    """Both parts' wear jumped together: each volume its k P s, and both
+    depth fields within the run's tolerance of the resolved run, in half
+    the turns resolved."""
+    resolved_model, resolved, model, state = ten_turns
+    js = state.jump
+    assert js.jumps >= 2 and js.resolved_steps <= 0.6 * model.n_steps
+    s = OMEGA * state.time * (R + A * A / (8.0 * R))
+    pin, disc = state.bodies[0].wear_volume.sum(), state.parts[0].volume.sum()
+    assert measured("jumped pin on worn disc: pin volume", pin, K_PIN * P * s, 5e-3) <= 5e-3
+    assert measured("jumped pin on worn disc: disc volume", disc, K_DISC * P * s, 5e-3) <= 5e-3
+    tolerance = model.scene.wear.tolerance
+    for label, got, want in (
+            ("pin", state.bodies[0].wear_depth, resolved.bodies[0].wear_depth),
+            ("disc", state.parts[0].depth, resolved.parts[0].depth)):
+        error = np.abs(got - want).max() / want.max()
+        assert measured(f"jumped vs resolved, {label} depth (of its deepest)", error, 0.0,
+                        tolerance) <= tolerance
+
+
+def test_a_checkpoint_inside_a_jumped_run_resumes_it(tmp_path):
+    """A jumped run saved after a jump and resumed ends where the whole run
+    does: the counter-part's wear and the jump controller's memory of it
+    are in the checkpoint."""
+    from meshwear.wear import run_cycle_jump
+    model = build_model(load_scene(_jumped(tmp_path, 6)))
+    saved = []
+
+    def save(model, state):
+        if state.jump.jumps == 1 and not saved:
+            checkpoint.save(tmp_path / "c.npz", model, state, 0.0)
+            saved.append(state.step)
+
+    full = run_cycle_jump(model, initial_state(model), checkpoint=save)
+    assert saved and full.jump.jumps >= 2
+    resumed = initial_state(model)
+    checkpoint.load(tmp_path / "c.npz", model, resumed)
+    assert resumed.step == saved[0] and resumed.jump.part_rate[0] is not None
+    run_cycle_jump(model, resumed)
+    for got, want in ((resumed.parts[0].depth, full.parts[0].depth),
+                      (resumed.bodies[0].wear_depth, full.bodies[0].wear_depth)):
+        assert np.abs(got - want).max() <= 1e-9 * want.max()
 
 
 def test_a_surface_frame_s_orientation_is_its_turn():

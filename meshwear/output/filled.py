@@ -74,10 +74,12 @@ def record(model, state, start, stop, cycles, observers, progress, compiled):
     return snapshots
 
 
-def write(model, state, stop, jump, snapshots, spans, observers):
+def write(model, state, stop, jump, snapshots, spans, observers, part_spans=()):
     """Write every output strictly inside the span the jump just covered
     (``stop`` to ``stop + jump`` cycles), filled from it (``spans``: per body,
-    the jumped arrays at its start and end, and the shift of its position)."""
+    the jumped arrays at its start and end, and the shift of its position;
+    ``part_spans`` the same per worn counter-part, in the order of
+    ``state.parts``)."""
     from ..simulate import check
 
     n_c = model.cycle_steps
@@ -92,6 +94,10 @@ def write(model, state, stop, jump, snapshots, spans, observers):
         view.step, view.time = o, o * model.dt
         view.bodies = [_view(body, s, shot, span, fraction, view.time)
                        for body, s, shot, span in zip(model.bodies, state.bodies, shots, spans)]
+        if part_spans:
+            spans_left = iter(part_spans)
+            view.parts = [None if p is None else _interpolated(p, next(spans_left), fraction)
+                          for p in state.parts]
         sample, frame = o in model.sample_set, o in model.frame_set
         if frame:
             check(model, view, [b.reference_face_normals for b in model.bodies])
@@ -101,6 +107,14 @@ def write(model, state, stop, jump, snapshots, spans, observers):
             if frame:
                 observer.on_frame(model, view)
         state.written = o
+
+
+def _interpolated(part, span, fraction):
+    """A worn counter-part at ``fraction`` of the jump."""
+    view = copy.copy(part)
+    for name, (first, last) in span.items():
+        setattr(view, name, first + fraction * (last - first))
+    return view
 
 
 def _view(body, s, shot, span, fraction, t):

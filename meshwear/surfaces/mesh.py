@@ -155,6 +155,12 @@ class MeshSurface(CounterSurface):
         self.vertices, self.frames, self.part = part.vertices, part.frames, part
         self._compiled = None
 
+    def rebin(self):
+        """Bin the faces anew where they are now (a worn part after a jump)."""
+        if self.grid is not None:
+            self.grid = build_grid(self.vertices, self.faces, self.face_normals, self.reach)
+            self._compiled = None
+
     def part_tuple(self):
         """The ``part`` tuple of :func:`meshwear.kernels.counter_wear.wear_counter`."""
         if not self.worn or self.part is None:     # (not attached to a state yet)
