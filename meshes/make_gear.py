@@ -84,23 +84,26 @@ def outline(module, teeth, pressure_angle=20.0, flank_points=16, tip_points=4, r
     return out[keep]
 
 
-def gear_mesh(module, teeth, width, pressure_angle=20.0, flank_points=16):
-    """(vertices (n, 3), faces (m, 3)) of the gear, mm, outward winding."""
+def gear_mesh(module, teeth, width, pressure_angle=20.0, flank_points=16, layers=1):
+    """(vertices (n, 3), faces (m, 3)) of the gear, mm, outward winding; the
+    flanks in ``layers`` rows of quads across the face width (the contact
+    points of a worn gear along its width)."""
     ring = outline(module, teeth, pressure_angle, flank_points)
     k = len(ring)
-    bottom = np.column_stack([ring, np.zeros(k)])
-    top = np.column_stack([ring, np.full(k, float(width))])
-    vertices = np.vstack([bottom, top, [[0.0, 0.0, 0.0]], [[0.0, 0.0, float(width)]]])
-    c0, c1 = 2 * k, 2 * k + 1
+    rings = [np.column_stack([ring, np.full(k, width * level / layers)])
+             for level in range(layers + 1)]
+    vertices = np.vstack(rings + [[[0.0, 0.0, 0.0]], [[0.0, 0.0, float(width)]]])
+    c0, c1 = (layers + 1) * k, (layers + 1) * k + 1
     j = np.arange(k)
     n = (j + 1) % k
-    faces = np.vstack([
-        np.column_stack([np.full(k, c0), n, j]),              # bottom, facing -z
-        np.column_stack([np.full(k, c1), k + j, k + n]),      # top, facing +z
-        np.column_stack([j, n, k + n]),                       # sides, facing out
-        np.column_stack([j, k + n, k + j]),
-    ])
-    return vertices, faces.astype(np.int64)
+    top = layers * k
+    faces = [np.column_stack([np.full(k, c0), n, j]),              # bottom, facing -z
+             np.column_stack([np.full(k, c1), top + j, top + n])]  # top, facing +z
+    for level in range(layers):                                   # sides, facing out
+        lo, hi = level * k, (level + 1) * k
+        faces += [np.column_stack([lo + j, lo + n, hi + n]),
+                  np.column_stack([lo + j, hi + n, hi + j])]
+    return vertices, np.vstack(faces).astype(np.int64)
 
 
 def main():
@@ -111,14 +114,16 @@ def main():
     parser.add_argument("--pressure-angle", type=float, default=20.0, help="degrees (20)")
     parser.add_argument("--flank-points", type=int, default=16,
                         help="points along each flank (16)")
+    parser.add_argument("--layers", type=int, default=1,
+                        help="rows of faces across the face width (1)")
     parser.add_argument("-o", "--output", type=Path, required=True, help="STL file to write")
     args = parser.parse_args()
-    if args.teeth < 6 or args.module <= 0.0 or args.width <= 0.0:
-        parser.error("need teeth >= 6, module > 0 and width > 0")
+    if args.teeth < 6 or args.module <= 0.0 or args.width <= 0.0 or args.layers < 1:
+        parser.error("need teeth >= 6, module > 0, width > 0 and layers >= 1")
     import trimesh
 
     vertices, faces = gear_mesh(args.module, args.teeth, args.width, args.pressure_angle,
-                                args.flank_points)
+                                args.flank_points, args.layers)
     mesh = trimesh.Trimesh(vertices, faces, process=False)
     mesh.export(args.output)
     print(f"{args.output}: {len(vertices)} vertices, {len(faces)} faces, "

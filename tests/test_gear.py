@@ -17,10 +17,13 @@ make_gear = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(make_gear)
 
 
-@pytest.mark.parametrize("module, teeth", [(2.0, 20), (1.5, 31), (3.0, 12)])
-def test_a_gear_is_a_closed_outward_mesh(module, teeth):
-    vertices, faces = make_gear.gear_mesh(module, teeth, 8.0)
+@pytest.mark.parametrize("module, teeth, layers", [(2.0, 20, 1), (1.5, 31, 1), (3.0, 12, 1),
+                                                  (2.0, 20, 4)])
+def test_a_gear_is_a_closed_outward_mesh(module, teeth, layers):
+    vertices, faces = make_gear.gear_mesh(module, teeth, 8.0, layers=layers)
     mesh = trimesh.Trimesh(vertices, faces, process=False)
+    # the flanks in rows across the face width
+    assert np.unique(np.round(vertices[:, 2], 9)).size == layers + 1
     assert mesh.is_watertight and mesh.is_winding_consistent
     # between the root and the tip discs, and outward (positive volume)
     r = 0.5 * module * teeth
