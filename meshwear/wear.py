@@ -399,7 +399,8 @@ def _jump_parts(model, parts, before_parts, part_rates, js, jump):
         part.depth += jump * rate
         part.volume += jump * (part.volume - volume0)
         part.work += jump * (part.work - work0)
-        part.vertices[:] = surface.reference_vertices - part.depth[:, None] * surface.vertex_normals
+        part.vertices[:] = (surface.reference_vertices
+                            - part.depth[:, None] * surface.vertex_normals)
         part.frames[:] = face_frames(part.vertices, surface.faces)
         surface.rebin()
         previous = js.part_rate[k]
