@@ -17,6 +17,11 @@ slider_shoe_mm.stl
     36 x 12 mm running face is two triangles, the side faces are fans of long
     slivers (aspect ratios up to ~60). meshwear refines it where it can touch
     (``resolution`` in examples/cad_part.toml).
+bushing_d10.1_mm.stl
+    A plain bushing: bore 10.1 mm, outer diameter 16 mm, 3 mm long, its axis
+    along z from z = -1.5 to 1.5 mm; 1024 facets round the bore (each 31 µm
+    wide), so a shaft 0.1 mm smaller rests on several of them
+    (examples/shaft_in_worn_bushing.toml).
 """
 
 from pathlib import Path
@@ -75,7 +80,13 @@ def shoe(width=12.0, segments=24):
     return vertices, faces
 
 
+def bushing():
+    mesh = trimesh.creation.annulus(r_min=5.05, r_max=8.0, height=3.0, sections=1024)
+    return mesh.vertices, mesh.faces
+
+
 if __name__ == "__main__":
     save("cube_20mm.stl", *cube())
     save("block_10x10x5mm.stl", *block())
     save("slider_shoe_mm.stl", *shoe())
+    save("bushing_d10.1_mm.stl", *bushing())
