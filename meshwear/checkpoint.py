@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .output.tables import replace_atomic
 from .scene import SceneError
 
 FILE_NAME = "checkpoint.npz"
@@ -76,7 +77,7 @@ def save(path, model, state, wall_time):
     try:
         with os.fdopen(fd, "wb") as f:
             np.savez(f, **arrays)
-        os.replace(tmp, path)
+        replace_atomic(tmp, path)
     except BaseException:
         try:
             os.unlink(tmp)

@@ -10,6 +10,8 @@ import time
 from pathlib import Path
 
 EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL = 0, 2, 3
+#: a run stopped by SIGTERM or Ctrl-C at a checkpoint (128 + the signal's number)
+EXIT_TERMINATED, EXIT_INTERRUPTED = 143, 130
 
 
 class InputError(Exception):
@@ -115,9 +117,23 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=
         saver.remove()   # a checkpoint of an earlier run in OUT no longer applies
     if resume and not quiet:
         print(f"resuming at t = {state.time:.6g} s (step {state.step} of {model.n_steps})")
-    progress = None if quiet or not sys.stderr.isatty() else _ProgressBar(model)
+    progress = (None if quiet else _ProgressBar(model) if sys.stderr.isatty()
+                else _ProgressLines(model))
+    stopping = _StopRequests(saver)
     try:
-        run(model, state, observers=[recorder], progress=progress, checkpoint=saver)
+        with stopping:
+            run(model, state, observers=[recorder], progress=progress, checkpoint=stopping)
+    except _Stopped as stop:
+        if progress:
+            progress.finish()
+        status, code = ("terminated", EXIT_TERMINATED) if stop.terminated else ("interrupted",
+                                                                               EXIT_INTERRUPTED)
+        recorder.close(summary(model, state, saver.wall_time, status,
+                               f"{status} at t = {state.time:.6g} s"))
+        print(f"meshwear: {status} at t = {state.time:.6g} s (step {state.step} of "
+              f"{model.n_steps}); checkpoint saved: continue with "
+              f"meshwear run {scene_path} -o {out_dir} --resume", file=sys.stderr)
+        return code
     except KeyboardInterrupt:
         if progress:
             progress.finish()
@@ -226,6 +242,85 @@ def _info(mesh_path, units):
     for key, value in info.items():
         print(f"{key}: {value}")
     return EXIT_OK
+
+
+class _Stopped(Exception):
+    """The run stopped at a checkpoint on SIGTERM or Ctrl-C."""
+
+    def __init__(self, terminated):
+        super().__init__("terminated" if terminated else "interrupted")
+        self.terminated = terminated
+
+
+class _StopRequests:
+    """SIGTERM (what batch schedulers send) and Ctrl-C ask the run to stop at
+    its next consistent state (where it may save a checkpoint): there a
+    checkpoint is saved and :class:`_Stopped` raised. A second Ctrl-C stops
+    at once (the outputs written so far stay valid, without a checkpoint).
+    Used as the run's ``checkpoint`` hook, wrapping the :class:`Checkpointer`."""
+
+    def __init__(self, saver):
+        self.saver, self.requested, self.terminated = saver, False, False
+        self._previous = {}
+
+    def __enter__(self):
+        import signal
+
+        for number in (signal.SIGTERM, signal.SIGINT):
+            try:
+                self._previous[number] = signal.signal(number, self._handle)
+            except ValueError:                # not the main thread: leave them be
+                pass
+        return self
+
+    def __exit__(self, *exc):
+        import signal
+
+        for number, handler in self._previous.items():
+            signal.signal(number, handler)
+
+    def _handle(self, number, frame):
+        import signal
+
+        if self.requested and number == signal.SIGINT:
+            raise KeyboardInterrupt
+        self.requested = True
+        self.terminated = self.terminated or number == signal.SIGTERM
+
+    def __call__(self, model, state):
+        if self.requested:
+            from .checkpoint import save
+
+            save(self.saver.path, model, state, self.saver.wall_time)
+            raise _Stopped(self.terminated)
+        self.saver(model, state)
+
+
+class _ProgressLines:
+    """Plain progress lines on stderr when it is not a terminal (nohup, batch
+    jobs, notebooks): one every :data:`LINE_SECONDS` of wall time."""
+
+    #: seconds between two lines
+    LINE_SECONDS = 30.0
+
+    def __init__(self, model):
+        self.model, self.start = model, time.perf_counter()
+        self.written = self.start
+
+    def __call__(self, step, n_steps):
+        now = time.perf_counter()
+        if now - self.written < self.LINE_SECONDS or step >= n_steps:
+            return
+        self.written = now
+        done = step / max(n_steps, 1)
+        elapsed = now - self.start
+        eta = f"{elapsed / done - elapsed:.0f} s" if done > 0 else "--"
+        print(f"meshwear: {100 * done:.1f} % t = {step * self.model.dt:.6g} s "
+              f"(step {step} of {n_steps}), {elapsed:.0f} s elapsed, eta {eta}",
+              file=sys.stderr, flush=True)
+
+    def finish(self):
+        pass
 
 
 class _ProgressBar:

@@ -4,6 +4,7 @@ the same numbers as a run never interrupted (docs/outputs.md, "Checkpoints": 1e-
 import csv
 import dataclasses
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -75,6 +76,60 @@ def test_sigkill_then_resume_matches_an_uninterrupted_run(tmp_path):
     frames = sorted(p.name for p in (cut / "block").iterdir())
     assert frames == sorted(p.name for p in (full / "block").iterdir())
     assert (cut / "block.pvd").read_text() == (full / "block.pvd").read_text()
+
+
+@pytest.mark.parametrize("number, code, status", [(signal.SIGTERM, 143, "terminated"),
+                                                   (signal.SIGINT, 130, "interrupted")])
+def test_sigterm_or_ctrl_c_stop_at_a_checkpoint_and_resume(tmp_path, number, code, status):
+    """A batch scheduler's SIGTERM (or Ctrl-C) stops the run at its next
+    consistent state: a checkpoint, summary.json with the status, exit 143
+    (130); --resume ends with the numbers of a run never stopped. Progress
+    goes to stderr as plain lines (not a terminal); every file is 0644
+    under umask 022."""
+    scene = _block_scene(tmp_path)
+    full, cut = tmp_path / "full", tmp_path / "cut"
+    assert _meshwear("run", scene, "-o", full, "-q").wait(timeout=300) == 0
+    mask = os.umask(0o022)                # the runs below inherit it
+    try:
+        job = _meshwear("run", scene, "-o", cut)
+    finally:
+        os.umask(mask)
+    deadline = time.time() + 120
+    while not (cut / "history.csv").exists() or len(_rows(cut / "history.csv")) < 4:
+        assert job.poll() is None, "the run ended before it could be stopped"
+        assert time.time() < deadline
+        time.sleep(0.05)
+    job.send_signal(number)
+    out, err = job.communicate(timeout=120)
+    assert job.returncode == code, err
+    assert f"meshwear: {status} at t = " in err and "--resume" in err
+    summary = json.loads((cut / "summary.json").read_text())
+    assert summary["status"] == status
+    assert (cut / checkpoint.FILE_NAME).exists()
+    for path in [cut / checkpoint.FILE_NAME, cut / "summary.json", cut / "history.csv",
+                 cut / "block.pvd", *sorted((cut / "block").iterdir())[:2]]:
+        assert path.stat().st_mode & 0o777 == 0o644, path
+
+    resumed = _meshwear("run", scene, "-o", cut, "--resume", "-q")
+    out, err = resumed.communicate(timeout=300)
+    assert resumed.returncode == 0, err
+    a = json.loads((full / "summary.json").read_text())["bodies"]["block"]
+    b = json.loads((cut / "summary.json").read_text())["bodies"]["block"]
+    for key in ("max_wear_depth", "wear_volume", "friction_work"):
+        assert b[key] == pytest.approx(a[key], rel=1e-9, abs=0.0)
+    assert _rows(cut / "history.csv") == _rows(full / "history.csv")
+
+
+def test_progress_lines_when_not_a_terminal(tmp_path, monkeypatch, capsys):
+    """Without a terminal, progress is a plain line every LINE_SECONDS."""
+    from meshwear import cli
+
+    monkeypatch.setattr(cli._ProgressLines, "LINE_SECONDS", 0.0)
+    progress = cli._ProgressLines(build_model(load_scene(_block_scene(tmp_path, 0.05))))
+    progress(10, 40)
+    progress(40, 40)                      # the end: the run's own report says it
+    err = capsys.readouterr().err
+    assert err.startswith("meshwear: 25.0 % t = ") and "eta" in err and err.count("\n") == 1
 
 
 class _Stop(Exception):

@@ -103,6 +103,21 @@ def write_json_atomic(path, obj):
     write_text_atomic(path, json.dumps(_plain(obj), indent=2, allow_nan=False) + "\n")
 
 
+def file_mode():
+    """The mode a new file gets under the process's umask (0644 under the
+    usual 022): temporary files are created 0600, and their replacement must
+    not keep that (colleagues on a shared disk open the outputs too)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+def replace_atomic(tmp, path):
+    """Give ``tmp`` the mode of a new file and move it over ``path``."""
+    os.chmod(tmp, file_mode())
+    os.replace(tmp, path)
+
+
 def write_text_atomic(path, text):
     """Replace ``path`` by ``text`` atomically (temporary file in the same directory).
 
@@ -113,7 +128,7 @@ def write_text_atomic(path, text):
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
             f.write(text)
-        os.replace(tmp, path)
+        replace_atomic(tmp, path)
     except BaseException:
         try:
             os.unlink(tmp)
