@@ -5,6 +5,7 @@ arrays once; :func:`initial_state` allocates every per-vertex array a run
 writes into, so a step allocates no state. Kernels see only these arrays.
 """
 
+import logging
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -261,8 +262,10 @@ def build_model(scene):
         cycle_steps, dt, n_steps = _cycle_timing(scene)
     for key in ("frames", "history"):
         if getattr(run, key) > n_steps + 1:
-            raise SceneError(scene.source, f"run.{key}", f"{getattr(run, key)} samples are more than "
-                             f"the {n_steps + 1} step times of the run (duration / dt + 1)")
+            # a short run (a trial, a --set run.duration) writes at every step
+            logging.getLogger("meshwear").warning(
+                "%s: run.%s: %d asked, but the run has %d step times (duration / dt + 1): "
+                "writing one at each", scene.source, key, getattr(run, key), n_steps + 1)
     bodies = []
     for j, b in enumerate(scene.bodies):
         try:

@@ -289,8 +289,6 @@ BAD_SCENES = [
     ("force_overflows", BASE.replace("position = [0.0, 0.0, 0.0025]",
                                      "position = [0.0, 0.0, 0.0025]\nforce = [1e308, 0.0, 0.0]"),
      {}, ["body[0].force", "overflows the acceleration"]),
-    ("more_frames_than_steps", BASE.replace("frames = 3", "frames = 5000"), {},
-     ["run.frames", "5000 samples are more than the 1001 step times"]),
     ("dt_above_stability_limit", BASE.replace("dt = 1e-5", "dt = 1e-3"), {},
      ["run.dt", "stability limit", "largest stable dt"]),
     ("body_inside_a_mesh_surface",
@@ -738,3 +736,18 @@ def test_check_of_a_cycle_jumping_scene_says_how_it_jumps(capsys, caplog):
     assert ("cycle jumping: 20 steps per cycle, 100000 cycles, implicit jumps, tolerance 0.01; "
             "outputs inside jumps are filled from them") in out
     assert "if every cycle were resolved" in out
+
+
+def test_a_short_run_writes_a_frame_and_a_row_at_each_step(tmp_path, capsys, caplog):
+    """More frames and history rows than step times (a trial with a short
+    duration): one at each step time, and a warning naming the keys."""
+    scene = write(tmp_path / "scene.toml",
+                  BASE.replace("duration = 0.01", "duration = 4e-5")
+                  .replace("frames = 3", "frames = 51").replace("history = 5", "history = 1001"))
+    code, out, err = cli(capsys, caplog, "run", scene, "-o", tmp_path / "out", "-q")
+    assert code == 0, err
+    assert any("run.frames: 51 asked, but the run has 5 step times" in line for line in err)
+    assert any("run.history: 1001 asked" in line for line in err)
+    assert len(pvd_entries(tmp_path / "out" / "block.pvd")) == 5
+    rows = (tmp_path / "out" / "history.csv").read_text().splitlines()
+    assert len(rows) == 1 + 5                # the header, then the block at 5 times
