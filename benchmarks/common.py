@@ -3,6 +3,7 @@ the generated section of a docs page."""
 
 import tempfile
 import time
+from pathlib import Path
 
 from meshwear.model import build_model, check_time_step, initial_state
 from meshwear.output.recorder import RunRecorder, summary
@@ -34,3 +35,16 @@ def replace_section(page, start, end, section):
     else:
         text = text.rstrip("\n") + "\n\n" + section + "\n"
     page.write_text(text)
+
+
+def write_measured(name, rows, figure, caption):
+    """The measured section of docs/examples/``name``.md, as
+    benchmarks/``name``.py writes it: a table of ``rows`` ((quantity,
+    measured) pairs) and the figure docs/img/``figure`` under ``caption``."""
+    start, end = f"<!-- {name}:start -->", f"<!-- {name}:end -->"
+    lines = [start, "", f"<!-- written by benchmarks/{name}.py -->", "",
+             "| quantity | measured |", "|---|---:|"]
+    lines += [f"| {quantity} | {value} |" for quantity, value in rows]
+    lines += ["", f"![{caption}](../img/{figure})", "", end]
+    page = Path(__file__).resolve().parents[1] / "docs" / "examples" / f"{name}.md"
+    replace_section(page, start, end, "\n".join(lines))

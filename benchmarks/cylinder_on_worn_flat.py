@@ -21,15 +21,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from common import replace_section, timed_run  # noqa: E402
+from common import timed_run, write_measured  # noqa: E402
 from meshwear.kernels.contact import rotation_entries  # noqa: E402
 from meshwear.scene import load_scene  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "cylinder_on_worn_flat.toml"
-PAGE = ROOT / "docs" / "examples" / "cylinder_on_worn_flat.md"
 FIGURE = ROOT / "docs" / "img" / "cylinder_on_worn_flat.png"
-MARK_START, MARK_END = "<!-- cylinder_on_worn_flat:start -->", "<!-- cylinder_on_worn_flat:end -->"
 
 
 def main():
@@ -88,17 +86,15 @@ def plot(model, state, amplitude):
 
 
 def write_page(r):
-    lines = [MARK_START, "", "<!-- written by benchmarks/cylinder_on_worn_flat.py -->", "",
-             "| quantity | measured |", "|---|---:|",
-             f"| wall time (build, run, outputs) | {r['wall']:.1f} s ({r['steps']} steps, "
-             f"{r['cylinder_vertices']:,} cylinder and {r['flat_vertices']:,} flat vertices) |",
-             f"| cylinder's worn volume vs $k_{{cyl}} P s$ | {r['cylinder_volume_error']:+.1e} |",
-             f"| flat's worn volume vs $k_{{flat}} P s$ | {r['flat_volume_error']:+.1e} |",
-             f"| deepest wear, cylinder / flat | {1e9 * r['cylinder_depth']:.1f} nm / "
-             f"{1e9 * r['flat_depth']:.1f} nm |",
-             f"| contact forces on the two parts, summed | {r['force_sum']:.1e} N |",
-             "", "![both scars](../img/cylinder_on_worn_flat.png)", "", MARK_END]
-    replace_section(PAGE, MARK_START, MARK_END, "\n".join(lines))
+    write_measured("cylinder_on_worn_flat", [
+        ("wall time (build, run, outputs)", f"{r['wall']:.1f} s ({r['steps']} steps, "
+         f"{r['cylinder_vertices']:,} cylinder and {r['flat_vertices']:,} flat vertices)"),
+        ("cylinder's worn volume vs $k_{cyl} P s$", f"{r['cylinder_volume_error']:+.1e}"),
+        ("flat's worn volume vs $k_{flat} P s$", f"{r['flat_volume_error']:+.1e}"),
+        ("deepest wear, cylinder / flat",
+         f"{1e9 * r['cylinder_depth']:.1f} nm / {1e9 * r['flat_depth']:.1f} nm"),
+        ("contact forces on the two parts, summed", f"{r['force_sum']:.1e} N"),
+    ], FIGURE.name, "both scars")
 
 
 if __name__ == "__main__":

@@ -28,7 +28,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from common import replace_section, timed_run  # noqa: E402
+from common import timed_run, write_measured  # noqa: E402
 from meshwear.scene import load_scene  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -36,9 +36,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 import cases  # noqa: E402
 
 SCENE = ROOT / "examples" / "pin_on_worn_disc.toml"
-PAGE = ROOT / "docs" / "examples" / "pin_on_worn_disc.md"
 FIGURE = ROOT / "docs" / "img" / "pin_on_worn_disc_track.png"
-MARK_START, MARK_END = "<!-- pin_on_worn_disc:start -->", "<!-- pin_on_worn_disc:end -->"
 
 
 def main():
@@ -107,18 +105,16 @@ def plot(u, depth, running, expected, a, track, scale):
 
 
 def write_page(r):
-    lines = [MARK_START, "", "<!-- written by benchmarks/pin_on_worn_disc.py -->", "",
-             "| quantity | measured |", "|---|---:|",
-             f"| wall time (build, run, outputs) | {r['wall']:.1f} s ({r['steps']} steps, "
-             f"{r['pin_vertices']:,} pin and {r['disc_vertices']:,} disc vertices) |",
-             f"| pin's worn volume vs $k_{{pin}} P s$ | {r['pin_volume_error']:+.1e} |",
-             f"| disc's worn volume vs $k_{{disc}} P s$ | {r['disc_volume_error']:+.1e} |",
-             f"| disc track vs the arc law (largest, within 0.8 a) | {r['track_error']:.1e} "
-             f"of the centre depth (rms {r['track_rms']:.1e}) |",
-             f"| friction work, disc vs pin | {r['work_difference']:+.1e} |",
-             f"| contact forces on the two parts, summed | {r['force_sum']:.1e} N |",
-             "", "![the disc's track](../img/pin_on_worn_disc_track.png)", "", MARK_END]
-    replace_section(PAGE, MARK_START, MARK_END, "\n".join(lines))
+    write_measured("pin_on_worn_disc", [
+        ("wall time (build, run, outputs)", f"{r['wall']:.1f} s ({r['steps']} steps, "
+         f"{r['pin_vertices']:,} pin and {r['disc_vertices']:,} disc vertices)"),
+        ("pin's worn volume vs $k_{pin} P s$", f"{r['pin_volume_error']:+.1e}"),
+        ("disc's worn volume vs $k_{disc} P s$", f"{r['disc_volume_error']:+.1e}"),
+        ("disc track vs the arc law (largest, within 0.8 a)",
+         f"{r['track_error']:.1e} of the centre depth (rms {r['track_rms']:.1e})"),
+        ("friction work, disc vs pin", f"{r['work_difference']:+.1e}"),
+        ("contact forces on the two parts, summed", f"{r['force_sum']:.1e} N"),
+    ], FIGURE.name, "the disc's track")
 
 
 if __name__ == "__main__":

@@ -20,14 +20,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from common import replace_section, timed_run  # noqa: E402
+from common import timed_run, write_measured  # noqa: E402
 from meshwear.scene import load_scene  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "shaft_in_worn_bushing.toml"
-PAGE = ROOT / "docs" / "examples" / "shaft_in_worn_bushing.md"
 FIGURE = ROOT / "docs" / "img" / "shaft_in_worn_bushing.png"
-MARK_START, MARK_END = "<!-- shaft_in_worn_bushing:start -->", "<!-- shaft_in_worn_bushing:end -->"
 
 
 def main():
@@ -92,19 +90,16 @@ def plot(model, state):
 
 
 def write_page(r):
-    lines = [MARK_START, "", "<!-- written by benchmarks/shaft_in_worn_bushing.py -->", "",
-             "| quantity | measured |", "|---|---:|",
-             f"| wall time (build, run, outputs) | {r['wall']:.1f} s ({r['steps']} steps, "
-             f"{r['shaft_vertices']:,} shaft and {r['bushing_vertices']:,} bushing vertices) |",
-             f"| shaft's worn volume vs $k_{{shaft}} P s$ | {r['shaft_volume_error']:+.1e} |",
-             f"| bushing's worn volume vs $k_{{bushing}} P s$ | "
-             f"{r['bushing_volume_error']:+.1e} |",
-             f"| deepest wear, shaft / bushing | {1e9 * r['shaft_depth']:.1f} nm / "
-             f"{1e9 * r['bushing_depth']:.1f} nm |",
-             f"| bushing worn within | {r['bushing_arc']:.1f}° of the load's direction |",
-             f"| contact forces on the two parts, summed | {r['force_sum']:.1e} N |",
-             "", "![both scars](../img/shaft_in_worn_bushing.png)", "", MARK_END]
-    replace_section(PAGE, MARK_START, MARK_END, "\n".join(lines))
+    write_measured("shaft_in_worn_bushing", [
+        ("wall time (build, run, outputs)", f"{r['wall']:.1f} s ({r['steps']} steps, "
+         f"{r['shaft_vertices']:,} shaft and {r['bushing_vertices']:,} bushing vertices)"),
+        ("shaft's worn volume vs $k_{shaft} P s$", f"{r['shaft_volume_error']:+.1e}"),
+        ("bushing's worn volume vs $k_{bushing} P s$", f"{r['bushing_volume_error']:+.1e}"),
+        ("deepest wear, shaft / bushing",
+         f"{1e9 * r['shaft_depth']:.1f} nm / {1e9 * r['bushing_depth']:.1f} nm"),
+        ("bushing worn within", f"{r['bushing_arc']:.1f}° of the load's direction"),
+        ("contact forces on the two parts, summed", f"{r['force_sum']:.1e} N"),
+    ], FIGURE.name, "both scars")
 
 
 if __name__ == "__main__":

@@ -35,7 +35,7 @@ import numpy as np
 from .kernels.balance import solve
 from .kernels.contact import FACING
 from .motion import BalancedMotion, GuidedMotion
-from .surfaces import quaternion_matrix
+from .surfaces import quaternion_matrix, vertex_feet
 
 
 def contact_geometry(model, body, s, index):
@@ -178,7 +178,6 @@ def counter_relief(model, s, m, increments, t):
     at the vertex's foot on the face it is over at ``t`` (the end of the
     cycle), and that per unit mean penetration."""
     counter = np.zeros(len(m.index))
-    R = quaternion_matrix(s.pose[3:7])
     for j, (surface, increment) in enumerate(zip(model.surfaces.per_vertex, increments)):
         if increment is None:
             continue
@@ -186,27 +185,7 @@ def counter_relief(model, s, m, increments, t):
         on = face >= 0
         if not on.any():
             continue
-        planes = s.vertex_planes[j][m.index[on]]
-        x = s.pose[0:3] + s.vertices[m.index[on]] @ R.T
-        normal = planes[:, 1]
-        foot = x - np.einsum("ij,ij->i", x - planes[:, 0], normal)[:, None] * normal
-        rotation, frame = surface.frame(t)
-        local = (foot - frame[0]) @ rotation
-        corners = surface.faces[face[on]]
-        weights = barycentric(local, surface.vertices[corners])
+        weights, corners = surface.face_weights(vertex_feet(s, j, m.index[on]), face[on], t)
         counter[on] += np.einsum("ij,ij->i", weights, increment[corners])
     m.counter = counter
     m.gamma = np.where(m.mean > 0.0, counter / np.where(m.mean > 0.0, m.mean, 1.0), 0.0)
-
-
-def barycentric(points, triangles):
-    """(k, 3) barycentric weights of ``points`` (k, 3) projected on
-    ``triangles`` (k, 3, 3), clipped to the triangle (non-negative, summing to 1)."""
-    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
-    n = np.cross(b - a, c - a)
-    area2 = np.einsum("ij,ij->i", n, n)
-    u = np.einsum("ij,ij->i", np.cross(c - b, points - b), n) / area2
-    v = np.einsum("ij,ij->i", np.cross(a - c, points - c), n) / area2
-    w = 1.0 - u - v
-    weights = np.maximum(np.stack([u, v, w], axis=1), 0.0)
-    return weights / weights.sum(axis=1)[:, None]

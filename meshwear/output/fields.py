@@ -3,7 +3,7 @@
 import numpy as np
 
 from ..kernels.contact import FORCE, rotation_entries
-from ..surfaces import contact_areas, slot_normals
+from ..surfaces import contact_areas, slot_normals, vertex_feet
 
 
 def body_totals(body, s):
@@ -92,18 +92,13 @@ def part_quantities(model, state, m):
         pairs = s.active[(s.normal_force[slot, s.active] > 0.0) & (s.hint[m, s.active] >= 0)]
         if not len(pairs):
             continue
-        planes = s.vertex_planes[m, pairs]
-        R = np.array(rotation_entries(s.pose[3:7])).reshape(3, 3)
-        x = s.pose[0:3] + s.vertices[pairs] @ R.T
-        delta = np.einsum("ij,ij->i", x - planes[:, 0], planes[:, 1])
-        foot = x - delta[:, None] * planes[:, 1]
+        foot = vertex_feet(s, m, pairs)
         load = s.normal_force[slot, pairs]
         friction = -s.tangential[slot, pairs, FORCE]
-        reaction = -load[:, None] * planes[:, 1] + friction
+        reaction = -load[:, None] * s.vertex_planes[m, pairs, 1] + friction
         force += reaction.sum(axis=0)
         torque += np.cross(foot - frame[0], reaction).sum(axis=0)
-        weights, corners = _face_weights(part.vertices, surface.faces,
-                                         (foot - frame[0]) @ rotation, s.hint[m, pairs])
+        weights, corners = surface.face_weights(foot, s.hint[m, pairs], state.time)
         for c in range(3):
             np.add.at(normal_force, corners[:, c], weights[:, c] * load)
             np.add.at(friction_force, corners[:, c], weights[:, c, None] * friction)
@@ -130,19 +125,3 @@ def part_quantities(model, state, m):
         "stick_points": int(counts[1]),
         "slip_points": int(counts[2]),
     }
-
-
-def _face_weights(vertices, faces, points, face):
-    """Barycentric weights (k, 3) of ``points`` (k, 3) projected on their
-    faces ``face`` (k,), clipped to the triangle, and the faces' corners."""
-    corners = faces[face]
-    a, b, c = (vertices[corners[:, j]] for j in range(3))
-    v0, v1, v2 = b - a, c - a, points - a
-    d00, d01, d11 = (np.einsum("ij,ij->i", p, q) for p, q in ((v0, v0), (v0, v1), (v1, v1)))
-    d20, d21 = np.einsum("ij,ij->i", v2, v0), np.einsum("ij,ij->i", v2, v1)
-    denom = d00 * d11 - d01 * d01
-    v = (d11 * d20 - d01 * d21) / denom
-    w = (d00 * d21 - d01 * d20) / denom
-    weights = np.clip(np.stack([1.0 - v - w, v, w], axis=1), 0.0, None)
-    weights /= weights.sum(axis=1, keepdims=True)
-    return weights, corners

@@ -8,7 +8,7 @@ states the contract) and is named in :data:`TYPES`, the scene's
 from .active import (CULL_MARGIN, CULL_POSE, CULL_SIZE, CULL_TIME, MARGIN_FRACTION,
                      STEPS_IN_MARGIN, Cull, SurfaceSet, body_margin, contact_areas, contact_faces,
                      initial_planes, margin_of, moved_since_refresh, needs_refresh, query,
-                     refresh, slot_normals, step_motion, update)
+                     refresh, slot_normals, step_motion, update, vertex_feet)
 from .analytic import Cylinder, Sphere
 from .base import CounterSurface, SurfaceMotion, quaternion_matrix
 from .mesh import MeshSurface
@@ -33,5 +33,6 @@ __all__ = ["TYPES", "build_surface", "CounterSurface", "SurfaceMotion", "Plane",
            "Sphere", "MeshSurface", "SurfaceSet", "Cull", "body_margin", "contact_areas",
            "contact_faces", "initial_planes", "margin_of", "moved_since_refresh",
            "needs_refresh", "query", "refresh", "slot_normals", "step_motion", "update",
+           "vertex_feet",
            "quaternion_matrix", "CULL_MARGIN", "CULL_POSE", "CULL_SIZE", "CULL_TIME",
            "MARGIN_FRACTION", "STEPS_IN_MARGIN"]

@@ -343,6 +343,16 @@ def slot_normals(model, s):
     return [p[1] for p in model.planes] + [vp[:, 1] for vp in s.vertex_planes]
 
 
+def vertex_feet(s, m, index):
+    """(k, 3) world feet of the vertices ``index`` of body state ``s`` on
+    the planes per-vertex surface ``m`` gives them."""
+    planes = s.vertex_planes[m][index]
+    R = quaternion_matrix(s.pose[3:7])
+    x = s.pose[0:3] + s.vertices[index] @ R.T
+    normal = planes[:, 1]
+    return x - np.einsum("ij,ij->i", x - planes[:, 0], normal)[:, None] * normal
+
+
 def contact_areas(body, s, normal):
     """(n,) contact area of each vertex of ``body`` (state ``s``) against a
     plane of ``normal`` ((3,) or (n, 3)): the area vector projected on it."""

@@ -155,6 +155,24 @@ class MeshSurface(CounterSurface):
         self.vertices, self.frames, self.part = part.vertices, part.frames, part
         self._compiled = None
 
+    def face_weights(self, points, face, t):
+        """Barycentric weights (k, 3) of world ``points`` (k, 3) at ``t`` on
+        the faces ``face`` (k,) (in its frame, as it is worn; projected on the
+        face and clipped to it) and those faces' corners (k, 3)."""
+        rotation, frame = self.frame(t)
+        local = (points - frame[0]) @ rotation
+        corners = self.faces[face]
+        a, b, c = (self.vertices[corners[:, j]] for j in range(3))
+        v0, v1, v2 = b - a, c - a, local - a
+        d00, d01, d11 = (np.einsum("ij,ij->i", p, q) for p, q in ((v0, v0), (v0, v1), (v1, v1)))
+        d20, d21 = np.einsum("ij,ij->i", v2, v0), np.einsum("ij,ij->i", v2, v1)
+        denom = d00 * d11 - d01 * d01
+        v = (d11 * d20 - d01 * d21) / denom
+        w = (d00 * d21 - d01 * d20) / denom
+        weights = np.clip(np.stack([1.0 - v - w, v, w], axis=1), 0.0, None)
+        weights /= weights.sum(axis=1, keepdims=True)
+        return weights, corners
+
     def rebin(self):
         """Bin the faces anew where they are now (a worn part after a jump)."""
         if self.grid is not None:
