@@ -12,6 +12,7 @@ Keys of bodies and surfaces are written by index: ``body[0].density``,
 ``surface[1].normal`` (0-based, in file order).
 """
 
+import copy
 import dataclasses
 import math
 import numbers
@@ -477,6 +478,8 @@ class Scene:
     surfaces: tuple = ()
     #: (key, value) pairs set over the file's (``--set``), part of its identity
     overrides: tuple = ()
+    #: the parsed TOML it was built from (None if built in code): :meth:`set` edits a copy
+    data: dict | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         def fail(key, message):
@@ -525,6 +528,46 @@ class Scene:
                 for x in self.bodies + self.surfaces):
             fail("wear.period", "missing; 'cycle_jump' needs a cycle length: set wear.period "
                  "or give a path with an oscillation or a circle")
+
+
+    def set(self, key, value=None):
+        """A copy with keys set by their dotted names, checked like a file's.
+
+        ``scene.set("wear.coefficient", 1e-13)`` or ``scene.set({"wear.coefficient":
+        1e-13, "body[0].force": [0, 0, -20]})`` (or a sequence of pairs): the names the errors print and
+        ``--set`` takes (:func:`set_key`). Values are TOML-like: numbers,
+        strings, booleans, lists (numpy arrays and scalars are converted),
+        tables as dicts. The settings join :attr:`overrides`.
+
+        Raises
+        ------
+        SceneError
+            Naming the key, for a bad key or value; for a scene built in code
+            (``data`` is None: use :func:`dataclasses.replace`).
+        """
+        values = ([(key, value)] if isinstance(key, str)
+                  else list(key.items()) if isinstance(key, dict) else list(key))
+        if self.data is None:
+            raise SceneError(self.source, values[0][0] if values else "",
+                             "this scene was not read from TOML; use dataclasses.replace")
+        values = [(k, _plain(v)) for k, v in values]
+        data = copy.deepcopy(self.data)
+        for k, v in values:
+            set_key(data, k, v, self.source)
+        scene = parse_scene(data, self.source, self.base_dir)
+        object.__setattr__(scene, "overrides", tuple(self.overrides) + tuple(values))
+        return scene
+
+
+def _plain(value):
+    """``value`` with numpy arrays and scalars turned into Python lists and numbers."""
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    return value
 
 
 def _check_format(value):
@@ -692,7 +735,7 @@ def parse_scene(data: dict, source: str = "<scene>", base_dir: Path = Path("."))
     surfaces = [_surface(source, base_dir, raw, f"surface[{j}]")
                 for j, raw in enumerate(_array(source, data.get("surface", []), "surface"))]
     return Scene(format=data["format"], source=source, base_dir=base_dir, bodies=tuple(bodies),
-                 surfaces=tuple(surfaces), **tables)
+                 surfaces=tuple(surfaces), data=copy.deepcopy(data), **tables)
 
 
 def _array(source, value, key):

@@ -54,30 +54,7 @@ class RunRecorder:
                                                        resume_until))
 
     def on_sample(self, model, state):
-        for body, s in zip(model.bodies, state.bodies):
-            q = body_totals(body, s)
-            row = dict(zip(("x", "y", "z"), q["origin"]))
-            row.update(zip(("qw", "qx", "qy", "qz"), s.pose[3:7]))
-            row.update(zip(("vx", "vy", "vz"), s.pose[7:10]))
-            row.update(zip(("wx", "wy", "wz"), s.pose[10:13]))
-            row.update(zip(("fx", "fy", "fz", "tx", "ty", "tz"), s.wrench))
-            row.update(time=state.time, body=body.name, friction_work=q["total_friction_work"],
-                       wear_volume=q["wear_volume"], max_wear_depth=q["max_wear_depth"],
-                       contact_points=q["contact_points"], stick_points=q["stick_points"],
-                       slip_points=q["slip_points"], resolved=int(state.resolved))
-            self.history.write(row)
-        for m in self.parts:
-            q = part_quantities(model, state, m)
-            row = dict(zip(("x", "y", "z"), q["origin"]))
-            row.update(zip(("qw", "qx", "qy", "qz"), q["orientation"]))
-            row.update(zip(("vx", "vy", "vz"), q["velocity"]))
-            row.update(zip(("wx", "wy", "wz"), q["angular_velocity"]))
-            row.update(zip(("fx", "fy", "fz", "tx", "ty", "tz"), q["wrench"]))
-            row.update(time=state.time, body=model.surfaces.per_vertex[m].name,
-                       friction_work=q["total_friction_work"], wear_volume=q["wear_volume"],
-                       max_wear_depth=q["max_wear_depth"], contact_points=q["contact_points"],
-                       stick_points=q["stick_points"], slip_points=q["slip_points"],
-                       resolved=int(state.resolved))
+        for row in history_rows(model, state):
             self.history.write(row)
 
     def on_frame(self, model, state):
@@ -99,6 +76,35 @@ class RunRecorder:
         for _, _, series in self.moving.values():
             series.close()
         write_json_atomic(self.out_dir / "summary.json", summary)
+
+
+def history_rows(model, state):
+    """The ``history.csv`` rows of ``state`` (docs/outputs.md), one dict per
+    body and worn counter-surface, keyed by column name."""
+    rows = []
+    for body, s in zip(model.bodies, state.bodies):
+        q = body_totals(body, s)
+        rows.append(_row(state, body.name, q, q["origin"], s.pose[3:7], s.pose[7:10],
+                         s.pose[10:13], s.wrench))
+    for m, surface in enumerate(model.surfaces.per_vertex):
+        if surface.worn:
+            q = part_quantities(model, state, m)
+            rows.append(_row(state, surface.name, q, q["origin"], q["orientation"],
+                             q["velocity"], q["angular_velocity"], q["wrench"]))
+    return rows
+
+
+def _row(state, name, q, origin, orientation, velocity, spin, wrench):
+    row = dict(zip(("x", "y", "z"), origin))
+    row.update(zip(("qw", "qx", "qy", "qz"), orientation))
+    row.update(zip(("vx", "vy", "vz"), velocity))
+    row.update(zip(("wx", "wy", "wz"), spin))
+    row.update(zip(("fx", "fy", "fz", "tx", "ty", "tz"), wrench))
+    row.update(time=state.time, body=name, friction_work=q["total_friction_work"],
+               wear_volume=q["wear_volume"], max_wear_depth=q["max_wear_depth"],
+               contact_points=q["contact_points"], stick_points=q["stick_points"],
+               slip_points=q["slip_points"], resolved=int(state.resolved))
+    return row
 
 
 def summary(model, state, wall_time, status="ok", message=None):
@@ -159,4 +165,4 @@ def summary(model, state, wall_time, status="ok", message=None):
     return out
 
 
-__all__ = ["RunRecorder", "summary", "HISTORY_COLUMNS", "EXTRA_COLUMNS"]
+__all__ = ["RunRecorder", "history_rows", "summary", "HISTORY_COLUMNS", "EXTRA_COLUMNS"]

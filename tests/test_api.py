@@ -1,0 +1,128 @@
+"""The Python interface (docs/api.md): load with keys set, Scene.set, run in
+memory with outputs and progress, per-part arrays, worn meshes, history
+columns and summary, all agreeing with the files ``meshwear run`` writes."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+import pyvista
+import trimesh
+
+import meshwear
+from meshwear.kernels.contact import rotation_entries
+from meshwear.scene import SceneError, load_scene
+from test_counter_wear import PIN_ON_WORN_DISC
+
+#: a tenth of a turn of the pin on a worn disc: both parts wear
+DURATION = 0.0628
+
+
+@pytest.fixture(scope="module")
+def scene_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("api") / "pin_on_worn_disc.toml"
+    path.write_text(PIN_ON_WORN_DISC.format(duration=DURATION, coefficient=2e-13, dt=2e-3))
+    return path
+
+
+@pytest.fixture(scope="module")
+def result(scene_file, tmp_path_factory):
+    calls = []
+    out = tmp_path_factory.mktemp("api_out")
+    scene = meshwear.load(scene_file, {"body[0].force": np.array([0.0, 0.0, -12.0])})
+    r = meshwear.run(scene, out=out, progress=lambda step, n: calls.append((step, n)),
+                     vertex_history=True)
+    r.calls = calls
+    return r
+
+
+def test_load_sets_keys_as_the_command_line_does(scene_file):
+    by_api = meshwear.load(scene_file, {"wear.coefficient": 3e-13, "body[0].force": [0, 0, -5]})
+    by_set = load_scene(scene_file, [("wear.coefficient", 3e-13), ("body[0].force", [0, 0, -5])])
+    assert by_api == by_set
+    assert by_api.wear.coefficient == 3e-13 and by_api.bodies[0].force == (0, 0, -5)
+
+
+def test_scene_set_makes_a_checked_copy(scene_file):
+    scene = meshwear.load(scene_file)
+    changed = scene.set("wear.coefficient", np.float64(5e-13)).set({"run.history": 3})
+    assert changed.wear.coefficient == 5e-13 and changed.run.history == 3
+    assert scene.wear.coefficient == 1e-13, "set changed the original"
+    assert changed.overrides == (("wear.coefficient", 5e-13), ("run.history", 3))
+    with pytest.raises(SceneError, match=r"wear\.coefficient"):
+        scene.set("wear.coefficient", -1.0)
+    with pytest.raises(SceneError, match=r"body\[3\]"):
+        scene.set("body[3].force", [0, 0, 1])
+
+
+def test_parts_are_the_bodies_and_the_worn_surfaces(result):
+    assert list(result.parts) == ["pin", "disc"]
+    assert [p.kind for p in result.parts.values()] == ["body", "surface"]
+    for name, part in result.parts.items():
+        entry = result.summary["bodies" if part.kind == "body" else "surfaces"][name]
+        assert part.wear_depth.max() > 0.0
+        assert part.wear_depth.max() == entry["max_wear_depth"]
+        assert part.history["wear_volume"][-1] == entry["wear_volume"]
+        assert set(part.fields) == {"wear_depth", "normal_force", "friction_force", "pressure",
+                                    "contact_state", "friction_work"}
+
+
+def test_the_load_was_set(result):
+    # quasi-static balance: the contact carries the 12 N set over the file's 10 N
+    assert result.parts["pin"].history["fz"][-1] == pytest.approx(12.0, rel=1e-3)
+
+
+def test_the_worn_mesh_is_in_the_part_s_frame(result):
+    pin = result.parts["pin"]
+    mesh = pin.mesh
+    assert mesh.is_watertight
+    body = result.model.bodies[0]
+    unworn = trimesh.Trimesh(body.reference_vertices - body.origin, body.faces, process=False)
+    # worn volume = the summary's, the worn vertices moved in by their depth
+    lost = unworn.volume - mesh.volume
+    assert lost == pytest.approx(result.summary["bodies"]["pin"]["wear_volume"], rel=0.02)
+    # the frame's world points are the part's own vertices placed by its pose
+    entry = result.summary["bodies"]["pin"]
+    R = np.array(rotation_entries(np.array(entry["orientation"]))).reshape(3, 3)
+    last = pyvista.read(sorted((result.out / "pin").glob("*.vtp"))[-1])
+    assert np.allclose(last.points, entry["position"] + pin.vertices @ R.T, atol=1e-9)
+
+
+def test_history_columns_match_history_csv(result):
+    with open(result.out / "history.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == len(result.history["time"])
+    for column, values in result.history.items():
+        if column == "body":
+            assert [r["body"] for r in rows] == list(values)
+        else:
+            assert np.allclose([float(r[column]) for r in rows], values.astype(float),
+                               rtol=1e-12, atol=0.0), column
+
+
+def test_summary_matches_summary_json(result):
+    written = json.loads((result.out / "summary.json").read_text())
+    assert written["bodies"] == result.summary["bodies"]
+    assert written["surfaces"] == result.summary["surfaces"]
+
+
+def test_vertex_history_only_when_asked(result, scene_file):
+    pin = result.parts["pin"]
+    assert pin.depth_history.shape == (len(pin.history["time"]), len(pin.vertices))
+    assert np.array_equal(pin.depth_history[-1], pin.wear_depth)
+    plain = meshwear.run(meshwear.load(scene_file, {"run.duration": 0.01}))
+    assert all(p.depth_history is None for p in plain.parts.values())
+    assert plain.out is None
+
+
+def test_progress_reaches_the_last_step(result):
+    n = result.model.n_steps
+    assert result.calls and result.calls[-1] == (n, n)
+    assert [s for s, _ in result.calls] == sorted(s for s, _ in result.calls)
+
+
+def test_the_package_exposes_the_interface():
+    assert {"load", "run", "Result", "Part", "Scene", "SceneError"} <= set(meshwear.__all__)
+    with pytest.raises(AttributeError):
+        meshwear.no_such_name
