@@ -1,4 +1,4 @@
-"""Command line: ``meshwear run | check | demo | info``.
+"""Command line: ``meshwear run | check | demo | export | info``.
 
 Exit codes: 0 ok, 2 bad input (one line on stderr naming the file and key),
 3 numerically invalid run (every output written so far stays valid).
@@ -38,6 +38,16 @@ def main(argv=None):
     p = sub.add_parser("demo", help="run the built-in demo scene")
     p.add_argument("-o", "--out", default="out/demo")
     p.add_argument("-q", "--quiet", action="store_true")
+    p = sub.add_parser("export", help="write the worn parts of a run as STL, PLY or OBJ")
+    p.add_argument("out", help="the run's output folder")
+    p.add_argument("--part", action="append", default=[], metavar="NAME",
+                   help="a worn body or surface (repeatable; default: all of them)")
+    p.add_argument("--frame", type=int, default=-1,
+                   help="frame number (0 the first, default -1 the last)")
+    p.add_argument("--format", default="stl", choices=("stl", "ply", "obj"))
+    p.add_argument("--units", default="m", help="units of the written files (m, mm, cm, um, in)")
+    p.add_argument("-d", "--dest", default=None,
+                   help="folder for the files (default: the output folder)")
     p = sub.add_parser("info", help="describe a mesh file")
     p.add_argument("mesh")
     p.add_argument("--units", default="m", help="units of the mesh file (m, mm, cm, um, in)")
@@ -48,6 +58,7 @@ def main(argv=None):
     logging.basicConfig(level=logging.WARNING, format="meshwear: %(message)s")
     # heavy imports only once the arguments are known
     from .geometry import MeshError
+    from .output.export import ExportError
     from .scene import SceneError
 
     try:
@@ -63,8 +74,10 @@ def main(argv=None):
             return _run(str(scene), args.out, args.quiet)
         if args.command == "check":
             return _check(args.scene, _overrides(args.set))
+        if args.command == "export":
+            return _export(args)
         return _info(args.mesh, args.units)
-    except (SceneError, MeshError, InputError) as err:
+    except (SceneError, MeshError, InputError, ExportError) as err:
         print(f"meshwear: error: {err}", file=sys.stderr)
         return EXIT_INPUT
     except KeyboardInterrupt:
@@ -233,6 +246,14 @@ def _surface_summary(surface, config):
                 f"{list(config.axis)} through {list(config.point)}, {length}")
     return (f"sphere {surface.name!r} ({config.side}): radius {config.radius:g} m, "
             f"centre {list(config.center)}")
+
+
+def _export(args):
+    from .output.export import export
+
+    for path in export(args.out, args.part, args.frame, args.format, args.units, args.dest):
+        print(path)
+    return EXIT_OK
 
 
 def _info(mesh_path, units):

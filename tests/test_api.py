@@ -11,6 +11,7 @@ import pyvista
 import trimesh
 
 import meshwear
+from meshwear.cli import main
 from meshwear.kernels.contact import rotation_entries
 from meshwear.scene import SceneError, load_scene
 from test_counter_wear import PIN_ON_WORN_DISC
@@ -126,3 +127,44 @@ def test_the_package_exposes_the_interface():
     assert {"load", "run", "Result", "Part", "Scene", "SceneError"} <= set(meshwear.__all__)
     with pytest.raises(AttributeError):
         meshwear.no_such_name
+
+
+@pytest.mark.parametrize("fmt", ["stl", "ply", "obj"])
+def test_export_writes_each_worn_part_in_its_own_frame(result, tmp_path, fmt):
+    dest = tmp_path / fmt
+    assert main(["export", str(result.out), "--format", fmt, "--units", "mm",
+                 "-d", str(dest)]) == 0
+    frames = len(result.model.frame_steps)
+    for name, part in result.parts.items():
+        path = dest / f"{name}_{frames - 1:05d}.{fmt}"
+        loaded = trimesh.load(path, process=False, force="mesh")
+        # the triangles of the worn part, in mm; STL holds float32
+        assert np.allclose(loaded.triangles * 1e-3, part.vertices[part.faces], rtol=0.0,
+                           atol=1e-9)
+
+
+def test_export_takes_a_frame_and_a_part(result, tmp_path):
+    assert main(["export", str(result.out), "--part", "disc", "--frame", "0",
+                 "-d", str(tmp_path)]) == 0
+    first = trimesh.load(tmp_path / "disc_00000.stl", process=False)
+    disc = result.parts["disc"]
+    unworn = result.model.surfaces.per_vertex[0].reference_vertices
+    assert np.allclose(first.triangles, unworn[disc.faces], atol=1e-9)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["disc_00000.stl"]
+
+
+@pytest.mark.parametrize("args, key", [
+    (["--part", "disco"], "--part disco"),
+    (["--frame", "99"], "--frame 99"),
+    (["--units", "furlong"], "--units furlong"),
+])
+def test_export_refuses_in_one_line(result, tmp_path, capsys, args, key):
+    assert main(["export", str(result.out), "-d", str(tmp_path), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and key in err
+    assert not list(tmp_path.iterdir())
+
+
+def test_export_refuses_a_folder_that_is_not_a_run(tmp_path, capsys):
+    assert main(["export", str(tmp_path)]) == 2
+    assert str(tmp_path) in capsys.readouterr().err

@@ -60,14 +60,17 @@ class RunRecorder:
     def on_frame(self, model, state):
         for body, s in zip(model.bodies, state.bodies):
             q = body_quantities(body, s, model)
-            self.series[body.name].write_frame(state.time, q["points"], {k: q[k] for k in FIELDS},
-                                               {"resolved": int(state.resolved)})
+            self.series[body.name].write_frame(
+                state.time, q["points"], {k: q[k] for k in FIELDS},
+                {"resolved": int(state.resolved), "origin": q["origin"],
+                 "orientation": s.pose[3:7]})
         for surface, vertices, series in self.moving.values():
             series.write_frame(state.time, surface.world_vertices(vertices, state.time), {})
         for m, series in self.parts.items():
             q = part_quantities(model, state, m)
             series.write_frame(state.time, q["points"], {k: q[k] for k in FIELDS},
-                               {"resolved": int(state.resolved)})
+                               {"resolved": int(state.resolved), "origin": q["origin"],
+                                "orientation": q["orientation"]})
 
     def close(self, summary):
         self.history.close()
