@@ -1,4 +1,4 @@
-"""Command line: ``meshwear run | check | demo | export | info``.
+"""Command line: ``meshwear run | check | demo | export | plot | info``.
 
 Exit codes: 0 ok, 2 bad input (one line on stderr naming the file and key),
 3 numerically invalid run (every output written so far stays valid).
@@ -48,6 +48,15 @@ def main(argv=None):
     p.add_argument("--units", default="m", help="units of the written files (m, mm, cm, um, in)")
     p.add_argument("-d", "--dest", default=None,
                    help="folder for the files (default: the output folder)")
+    p = sub.add_parser("plot", help="draw a run's wear maps, profiles and histories as PNG")
+    p.add_argument("out", help="the run's output folder")
+    p.add_argument("--part", action="append", default=[], metavar="NAME",
+                   help="a worn body or surface (repeatable; default: all of them)")
+    p.add_argument("--profile", metavar="X0,Y0,Z0:X1,Y1,Z1", default=None,
+                   help="wear profile under the line between two points (m, the part's own "
+                        "frame), as PNG and CSV; write --profile=... if it starts with '-'")
+    p.add_argument("-d", "--dest", default=None,
+                   help="folder for the files (default: OUT/plots)")
     p = sub.add_parser("info", help="describe a mesh file")
     p.add_argument("mesh")
     p.add_argument("--units", default="m", help="units of the mesh file (m, mm, cm, um, in)")
@@ -76,6 +85,8 @@ def main(argv=None):
             return _check(args.scene, _overrides(args.set))
         if args.command == "export":
             return _export(args)
+        if args.command == "plot":
+            return _plot(args)
         return _info(args.mesh, args.units)
     except (SceneError, MeshError, InputError, ExportError) as err:
         print(f"meshwear: error: {err}", file=sys.stderr)
@@ -252,6 +263,23 @@ def _export(args):
     from .output.export import export
 
     for path in export(args.out, args.part, args.frame, args.format, args.units, args.dest):
+        print(path)
+    return EXIT_OK
+
+
+def _plot(args):
+    from .output.plots import plot
+
+    line = None
+    if args.profile is not None:
+        bad = InputError(f"--profile {args.profile}: expected two points x0,y0,z0:x1,y1,z1 (m)")
+        try:
+            line = [[float(v) for v in point.split(",")] for point in args.profile.split(":")]
+        except ValueError:
+            raise bad from None
+        if len(line) != 2 or any(len(point) != 3 for point in line):
+            raise bad
+    for path in plot(args.out, args.part, args.dest, line):
         print(path)
     return EXIT_OK
 

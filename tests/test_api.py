@@ -168,3 +168,50 @@ def test_export_refuses_in_one_line(result, tmp_path, capsys, args, key):
 def test_export_refuses_a_folder_that_is_not_a_run(tmp_path, capsys):
     assert main(["export", str(tmp_path)]) == 2
     assert str(tmp_path) in capsys.readouterr().err
+
+
+def _picture(path):
+    import matplotlib.image
+
+    return matplotlib.image.imread(path)[..., :3]
+
+
+def test_plot_draws_non_blank_pictures(result, tmp_path):
+    line = "-0.001,0,-0.0015:0.001,0,-0.0015"      # across the pin's worn end face
+    assert main(["plot", str(result.out), "--part", "pin", f"--profile={line}",
+                 "-d", str(tmp_path)]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "history.png", "pin_profile.csv", "pin_profile.png", "pin_wear_map.png"]
+    for name in ("history.png", "pin_profile.png", "pin_wear_map.png"):
+        image = _picture(tmp_path / name)
+        assert image.std() > 0.05, f"{name} is blank"
+    # the wear map shows more than background and one colour
+    colours = np.unique((_picture(tmp_path / "pin_wear_map.png") * 255).astype(int).reshape(-1, 3),
+                        axis=0)
+    assert len(colours) > 20
+    with open(tmp_path / "pin_profile.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    depth = np.array([float(r["wear_depth"]) for r in rows])
+    pin = result.parts["pin"]
+    assert len(rows) > 100 and np.all(depth >= 0.0)
+    assert pin.wear_depth.max() * 0.5 < depth.max() <= pin.wear_depth.max() * (1 + 1e-12)
+    assert np.allclose([float(rows[0]["x"]), float(rows[-1]["x"])], [-1e-3, 1e-3], atol=1e-9)
+
+
+def test_plot_draws_every_worn_part_by_default(result, tmp_path):
+    assert main(["plot", str(result.out), "-d", str(tmp_path)]) == 0
+    assert {"pin_wear_map.png", "disc_wear_map.png", "history.png"} == {
+        p.name for p in tmp_path.iterdir()}
+
+
+@pytest.mark.parametrize("args, key", [
+    (["--profile=0,0,0:1,1"], "--profile"),
+    (["--profile=0,0,0:0,0,0", "--part", "pin"], "--profile"),
+    (["--profile=0,0,0:1,0,0"], "--profile"),                 # two parts: which?
+    (["--part", "disco"], "--part disco"),
+])
+def test_plot_refuses_in_one_line(result, tmp_path, capsys, args, key):
+    assert main(["plot", str(result.out), "-d", str(tmp_path / "p"), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and key in err
+    assert not (tmp_path / "p").exists(), "files written before the refusal"

@@ -1,0 +1,220 @@
+"""Pictures of a run's folder (``meshwear plot``, docs/outputs.md): a wear map
+of each worn part, wear profiles along a line, and the force and wear-volume
+histories, as PNG files (and the profiles as CSV).
+
+The wear map is drawn by pyvista off screen, the part in its own frame
+(:mod:`meshwear.output.export`) seen from outside its worn face; the curves
+by matplotlib (the ``plots`` extra).
+"""
+
+import csv
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .export import ExportError, part_mesh, series_frames, worn_parts
+
+#: pixels of the wear maps
+MAP_SIZE = (900, 700)
+#: samples along a profile line
+PROFILE_SAMPLES = 400
+
+
+def _pyplot():
+    try:
+        import matplotlib
+    except ImportError:
+        raise ExportError("meshwear plot needs matplotlib: pip install 'meshwear[plots]'") from None
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def plot(out_dir, names=None, dest=None, profile=None):
+    """Write the pictures of the run in ``out_dir``; return the paths written.
+
+    Parameters
+    ----------
+    names : sequence of str, optional
+        Worn parts to draw (default: all of them).
+    dest : path, optional
+        Folder for the files (default ``out_dir/plots``).
+    profile : ((3,), (3,)), optional
+        Two points of a line in the part's own frame (m): the wear depth
+        under it is written as ``<part>_profile.png`` and ``.csv``.
+    """
+    plt = _pyplot()
+    out_dir = Path(out_dir)
+    if not out_dir.is_dir():
+        raise ExportError(f"{out_dir}: no such output folder")
+    available = worn_parts(out_dir)
+    if not available:
+        raise ExportError(f"{out_dir}: no worn part's series here (a meshwear run's folder?)")
+    names = list(names) if names else available
+    for name in names:
+        if name not in available:
+            raise ExportError(f"--part {name}: not a worn part of {out_dir} "
+                              f"(there: {', '.join(available)})")
+    if profile is not None:
+        _line(profile)
+    if profile is not None and len(names) > 1:
+        raise ExportError("--profile: a line is in one part's frame; choose the part with --part "
+                          f"(there: {', '.join(names)})")
+    dest = Path(dest) if dest is not None else out_dir / "plots"
+    dest.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name in names:
+        written.append(wear_map(out_dir, name, dest / f"{name}_wear_map.png"))
+        if profile is not None:
+            written += wear_profile(out_dir, name, profile, dest / f"{name}_profile", plt)
+    history = out_dir / "history.csv"
+    if history.is_file():
+        written.append(history_plot(history, names, dest / "history.png", plt))
+    return written
+
+
+def _mesh_fields(out_dir, name, frame=-1):
+    import pyvista
+
+    vertices, faces, time = part_mesh(out_dir, name, frame)
+    path = series_frames(out_dir, name)[frame][1]
+    depth = np.asarray(pyvista.read(path).point_data["wear_depth"], float)
+    return vertices, faces, depth, time
+
+
+def wear_map(out_dir, name, path):
+    """The part at its last frame coloured by wear depth (µm), seen from
+    outside its worn face (along the wear-weighted mean of the outward
+    normals of its worn vertices), with a scale bar."""
+    if "DISPLAY" not in os.environ and "VTK_DEFAULT_OPENGL_WINDOW" not in os.environ:
+        # no X server: render through EGL (VTK's default would try X first
+        # and print a warning)
+        os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkEGLRenderWindow"
+    import pyvista
+
+    vertices, faces, depth, time = _mesh_fields(out_dir, name)
+    mesh = pyvista.PolyData(vertices, np.hstack([np.full((len(faces), 1), 3), faces]).ravel())
+    mesh.point_data["wear depth (µm)"] = depth * 1e6
+    normals = mesh.compute_normals(point_normals=True, cell_normals=False,
+                                   auto_orient_normals=False).point_data["Normals"]
+    weights = depth / depth.max() if depth.max() > 0.0 else np.ones(len(depth))
+    view = (weights[:, None] * normals).sum(axis=0)
+    if not np.linalg.norm(view) > 0.0:
+        view = np.array([0.0, 0.0, 1.0])
+    view /= np.linalg.norm(view)
+    up = np.cross(view, [0.0, 0.0, 1.0] if abs(view[2]) < 0.9 else [1.0, 0.0, 0.0])
+    up = np.cross(up, view)
+    try:
+        plotter = pyvista.Plotter(off_screen=True, window_size=MAP_SIZE)
+    except Exception as err:  # no OpenGL at all (a bare container)
+        raise ExportError(f"meshwear plot: cannot render off screen ({err}); install EGL or "
+                          "OSMesa, or run with a display") from None
+    plotter.set_background("white")
+    plotter.add_mesh(mesh, scalars="wear depth (µm)", cmap="viridis", show_edges=False,
+                     scalar_bar_args={"title": "wear depth (µm)\n", "color": "black",
+                                      "vertical": True, "fmt": "%.3g", "position_x": 0.8,
+                                      "position_y": 0.1, "width": 0.07, "height": 0.75,
+                                      "title_font_size": 14, "label_font_size": 12})
+    plotter.add_text(f"{name}, t = {time:.6g} s, deepest {depth.max() * 1e6:.3g} µm",
+                     font_size=10, color="black")
+    center = np.asarray(mesh.center)
+    distance = 3.0 * max(mesh.length, 1e-12)
+    plotter.camera_position = [tuple(center + distance * view), tuple(center), tuple(up)]
+    plotter.reset_camera()
+    plotter.camera.zoom(0.8)                # clear of the scale bar
+    plotter.screenshot(str(path))
+    plotter.close()
+    return path
+
+
+def wear_profile(out_dir, name, line, stem, plt):
+    """Wear depth at the end under the line ``line`` = (start, end) in the
+    part's own frame (m): each sample's nearest point on the unworn part
+    (frame 0), the depth interpolated there on the face found. Writes
+    ``stem.csv`` (distance, x, y, z, wear_depth, m) and ``stem.png``."""
+    import trimesh
+
+    start, end = _line(line)
+    unworn, faces, _ = part_mesh(out_dir, name, 0)
+    *_, depth, time = _mesh_fields(out_dir, name)
+    s = np.linspace(0.0, 1.0, PROFILE_SAMPLES)
+    samples = start + s[:, None] * (end - start)
+    triangles = unworn[faces]
+    closest, face = _closest_points(triangles, samples)
+    weights = trimesh.triangles.points_to_barycentric(triangles[face], closest)
+    weights = np.clip(weights, 0.0, None)
+    weights /= weights.sum(axis=1, keepdims=True)
+    values = (weights * depth[faces[face]]).sum(axis=1)
+    distance = s * np.linalg.norm(end - start)
+    with open(f"{stem}.csv", "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(["distance", "x", "y", "z", "wear_depth"])
+        for row in zip(distance, *closest.T, values):
+            writer.writerow([repr(float(v)) for v in row])
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    ax.plot(distance * 1e3, values * 1e6, color="C0")
+    ax.set_xlabel("distance along the line (mm)")
+    ax.set_ylabel("wear depth (µm)")
+    ax.set_title(f"{name}: wear profile at t = {time:.6g} s", fontsize=10)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(f"{stem}.png", dpi=120)
+    plt.close(fig)
+    return [Path(f"{stem}.png"), Path(f"{stem}.csv")]
+
+
+def _line(line):
+    """The two points of a profile line, checked."""
+    try:
+        start, end = (np.asarray(p, float) for p in line)
+    except (TypeError, ValueError):
+        raise ExportError("--profile: expected two points x,y,z (m, the part's own frame)") from None
+    if not (start.shape == end.shape == (3,) and np.all(np.isfinite([start, end]))):
+        raise ExportError("--profile: expected two points x,y,z (m, the part's own frame)")
+    if not np.linalg.norm(end - start) > 0.0:
+        raise ExportError("--profile: the two points are the same")
+    return start, end
+
+
+def _closest_points(triangles, points, candidates=24):
+    """Nearest point of the triangles to each point, and its triangle: the
+    exact nearest among the triangles of the ``candidates`` nearest centroids."""
+    import trimesh
+    from scipy.spatial import cKDTree
+
+    k = min(candidates, len(triangles))
+    _, near = cKDTree(triangles.mean(axis=1)).query(points, k=k)
+    near = np.asarray(near).reshape(len(points), k)
+    on = trimesh.triangles.closest_point(triangles[near.ravel()], np.repeat(points, k, axis=0))
+    distance = np.linalg.norm(on - np.repeat(points, k, axis=0), axis=1).reshape(-1, k)
+    best = distance.argmin(axis=1)
+    rows = np.arange(len(points))
+    return on.reshape(-1, k, 3)[rows, best], near[rows, best]
+
+
+def history_plot(history, names, path, plt):
+    """Contact force components and worn volume of each part against time."""
+    with open(history, newline="") as f:
+        rows = list(csv.DictReader(f))
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    for k, name in enumerate(names):
+        mine = [r for r in rows if r["body"] == name]
+        if not mine:
+            continue
+        t = np.array([float(r["time"]) for r in mine])
+        for axis, style in zip("xyz", ("-", "--", ":")):
+            top.plot(t, [float(r[f"f{axis}"]) for r in mine], style, color=f"C{k}",
+                     label=f"{name} f{axis}")
+        bottom.plot(t, [float(r["wear_volume"]) * 1e9 for r in mine], color=f"C{k}", label=name)
+    top.set_ylabel("contact force (N)")
+    bottom.set_ylabel("worn volume (mm³)")
+    bottom.set_xlabel("time (s)")
+    for ax in (top, bottom):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
