@@ -1,7 +1,8 @@
-"""Command line: ``meshwear run | check | demo | export | plot | info``.
+"""Command line: ``meshwear run | check | demo | sweep | export | plot | info``.
 
 Exit codes: 0 ok, 2 bad input (one line on stderr naming the file and key),
-3 numerically invalid run (every output written so far stays valid).
+3 numerically invalid run (every output written so far stays valid), 1 a
+sweep with failed runs.
 """
 
 import argparse
@@ -10,6 +11,8 @@ import time
 from pathlib import Path
 
 EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL = 0, 2, 3
+#: a sweep finished with failed runs (each a row of sweep.csv with its message)
+EXIT_FAILED_RUNS = 1
 #: a run stopped by SIGTERM or Ctrl-C at a checkpoint (128 + the signal's number)
 EXIT_TERMINATED, EXIT_INTERRUPTED = 143, 130
 
@@ -38,6 +41,23 @@ def main(argv=None):
     p = sub.add_parser("demo", help="run the built-in demo scene")
     p.add_argument("-o", "--out", default="out/demo")
     p.add_argument("-q", "--quiet", action="store_true")
+    p = sub.add_parser("sweep", help="run a scene over a grid or list of key values on Dask")
+    p.add_argument("scene", nargs="?", default=None,
+                   help="scene file (TOML; or scene = ... in the sweep file)")
+    p.add_argument("--vary", action="append", default=[], metavar="KEY=[V1, V2, ...]",
+                   help="a key and its values (repeatable): wear.coefficient=[1e-13, 2e-13]")
+    p.add_argument("-f", "--file", default=None, metavar="SWEEP",
+                   help="sweep file (TOML: scene, mode, [values] KEY = [...])")
+    p.add_argument("--mode", choices=("grid", "list"), default=None,
+                   help="every combination of the values (grid, default) or the i-th of each "
+                        "(list)")
+    p.add_argument("-o", "--out", default=None,
+                   help="output folder (default: out/<scene name>_sweep)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="a running Dask scheduler (default: a LocalCluster on this machine)")
+    p.add_argument("--workers", type=int, default=None,
+                   help="LocalCluster processes (default: one per core; 0: one run after "
+                        "another in this process)")
     p = sub.add_parser("export", help="write the worn parts of a run as STL, PLY or OBJ")
     p.add_argument("out", help="the run's output folder")
     p.add_argument("--part", action="append", default=[], metavar="NAME",
@@ -85,6 +105,8 @@ def main(argv=None):
             return _check(args.scene, _overrides(args.set))
         if args.command == "export":
             return _export(args)
+        if args.command == "sweep":
+            return _sweep(args)
         if args.command == "plot":
             return _plot(args)
         return _info(args.mesh, args.units)
@@ -257,6 +279,27 @@ def _surface_summary(surface, config):
                 f"{list(config.axis)} through {list(config.point)}, {length}")
     return (f"sphere {surface.name!r} ({config.side}): radius {config.radius:g} m, "
             f"centre {list(config.center)}")
+
+
+def _sweep(args):
+    from .sweep import from_arguments, run_sweep
+
+    if args.workers is not None and args.workers < 0:
+        raise InputError(f"--workers: must be >= 0, got {args.workers}")
+    sweep = from_arguments(args.scene, args.vary, args.file, args.mode)
+    if not sweep.scene.is_file():
+        raise InputError(f"{sweep.scene}: scene file not found")
+    out = Path(args.out) if args.out else Path("out") / f"{sweep.scene.stem}_sweep"
+    runs = sweep.runs()
+    print(f"sweep of {sweep.scene}: {len(runs)} runs ({sweep.mode} of "
+          f"{', '.join(sweep.keys)}) into {out}")
+    start = time.perf_counter()
+    rows = run_sweep(sweep, out, args.scheduler, args.workers,
+                     report=lambda line: print(f"  {line}", flush=True))
+    failed = sum(row["status"] != "ok" for row in rows)
+    print(f"done in {time.perf_counter() - start:.1f} s: {len(rows) - failed} ok, {failed} "
+          f"failed; table: {out / 'sweep.csv'}")
+    return EXIT_OK if not failed else EXIT_FAILED_RUNS
 
 
 def _export(args):

@@ -49,6 +49,13 @@ def plot(out_dir, names=None, dest=None, profile=None):
     out_dir = Path(out_dir)
     if not out_dir.is_dir():
         raise ExportError(f"{out_dir}: no such output folder")
+    if (out_dir / "sweep.csv").is_file() and not list(out_dir.glob("*.pvd")):
+        if names or profile is not None:
+            raise ExportError(f"{out_dir}: a sweep's folder: --part and --profile apply to a "
+                              "run's folder (one of its run_NNN)")
+        dest = Path(dest) if dest is not None else out_dir / "plots"
+        dest.mkdir(parents=True, exist_ok=True)
+        return [sweep_plot(out_dir / "sweep.csv", dest / "sweep.png", plt)]
     available = worn_parts(out_dir)
     if not available:
         raise ExportError(f"{out_dir}: no worn part's series here (a meshwear run's folder?)")
@@ -163,6 +170,51 @@ def wear_profile(out_dir, name, line, stem, plt):
     fig.savefig(f"{stem}.png", dpi=120)
     plt.close(fig)
     return [Path(f"{stem}.png"), Path(f"{stem}.csv")]
+
+
+def sweep_plot(table, path, plt):
+    """Each summary figure of a sweep against its first varied key, one line
+    per value of its second (the other keys, if any, as they come)."""
+    import json
+
+    with open(table, newline="") as f:
+        reader = csv.DictReader(f)
+        columns = reader.fieldnames or []
+        rows = [r for r in reader if r["status"] == "ok"]
+    if "status" not in columns:
+        raise ExportError(f"{table}: not a sweep table (no status column)")
+    keys = columns[1:columns.index("status")]
+    figures = [c for c in columns[columns.index("wall_time") + 1:] if c != "message"]
+    if not rows or not figures:
+        raise ExportError(f"{table}: no finished run to draw")
+    try:
+        x = np.array([float(r[keys[0]]) for r in rows])
+        xlabel = keys[0]
+    except ValueError:          # not a number (a vector, a word): the runs in order
+        x = np.arange(len(rows), dtype=float)
+        xlabel = f"run ({keys[0]})"
+    groups = [r[keys[1]] for r in rows] if len(keys) > 1 else [""] * len(rows)
+    fig, axes = plt.subplots(len(figures), 1, figsize=(7, 2.4 * len(figures)), sharex=True,
+                             squeeze=False)
+    for ax, figure in zip(axes[:, 0], figures):
+        for k, group in enumerate(dict.fromkeys(groups)):
+            pick = np.array([g == group for g in groups])
+            y = np.array([float(r[figure]) if r[figure] else np.nan for r in rows])[pick]
+            order = np.argsort(x[pick])
+            ax.plot(x[pick][order], y[order], "o-", color=f"C{k}",
+                    label=f"{keys[1]} = {group}" if group else None)
+        ax.set_ylabel(figure, fontsize=8)
+        ax.grid(alpha=0.3)
+        if len(keys) > 1:
+            ax.legend(fontsize=7)
+    axes[-1, 0].set_xlabel(xlabel)
+    if xlabel.startswith("run ("):
+        axes[-1, 0].set_xticks(x, [json.dumps(r[keys[0]])[1:-1] for r in rows], fontsize=7,
+                               rotation=20)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
 
 
 def _line(line):
