@@ -1,27 +1,34 @@
 """Implicit (backward-Euler) wear jumps and their error (docs/model.md, "Long durations").
 
 On a Winkler foundation a vertex's pressure is linear in its elastic
-penetration ``p_i``, and Archard's and the energy laws make its wear rate
-linear in its pressure, so over a resolved cycle ``r_i = alpha_i pbar_i``
-(``pbar_i`` the cycle's mean penetration: its mean normal force over its
-stiffness). A jump of ``J`` cycles solves, backward Euler,
+penetration, and Archard's and the energy laws make its wear rate linear in
+its pressure, so over a resolved cycle ``r_i = alpha_i pbar_i``, ``pbar_i``
+its penetration while in contact (its force-weighted mean normal force over
+its stiffness: the cycle's penetration whether the vertex touches all the
+cycle, a pin's, or for a few steps of it, a gear flank's). Wear and a move
+``z`` of a guided body along its axis take the same amount off its
+penetration at every step it touches, so a jump of ``J`` cycles solves,
+backward Euler,
 
-    w_i = J alpha_i (p_i - beta_i z - w_i),     sum_i c_i beta_i (p_i - beta_i z - w_i)_+ = L,
+    w_i = J alpha_i (pbar_i - beta_i z - w_i)_+,    sum_i c_i beta_i (p_i - beta_i z - w_i)_+ = L,
 
 ``p_i`` the penetration at the end of the cycle on the surface nearest the
-vertex, ``beta_i`` the free axis along its normal, ``z`` the move of a guided
-body along its axis, ``L`` its load: each vertex's penetration becomes
-``(p_i - beta_i z) / (1 + J alpha_i)`` and ``z`` is a 1-D monotone solve
-(:func:`balance`). A vertex touched during the cycle but not at its end (a
-gear flank) wears ``J alpha_i pbar_i / (1 + J alpha_i)``: bounded by its
-penetration, whatever ``J``. A vertex out of contact that the move brings in
-wears as the contact does on average per unit penetration.
+vertex, ``beta_i`` the free axis along its normal, ``L`` the load: each
+vertex wears ``J alpha_i (pbar_i - beta_i z) / (1 + J alpha_i)`` (at most
+its penetration, whatever ``J``), its end penetration becomes
+``(p_i + J alpha_i (p_i - pbar_i) - beta_i z) / (1 + J alpha_i)`` and ``z`` is
+a 1-D monotone solve (:func:`balance`). A vertex touched during the cycle
+but not at its end wears alike but does not take part in the balance (its
+normal, if it faces no surface then, is its own). A vertex out of contact that the move
+brings in wears as the contact does on average per unit penetration, from
+its gap at the end of the cycle.
 
 A worn counter-part relieves a vertex too: the counter's wear under it in
-the cycle, ``r_c,i = gamma_i pbar_i`` (linear in the pressure alike), adds to
-the relief, ``(p_i - beta_i z) / (1 + J (alpha_i + gamma_i))``, while the
-vertex itself wears ``J alpha_i`` times that (:func:`counter_relief`; the
-counter-part's own wear is extrapolated in :mod:`meshwear.wear`).
+the cycle, ``r_c,i = gamma_i pbar_i`` (linear in the pressure alike), takes
+off its penetration with its own: ``alpha_i`` becomes ``alpha_i + gamma_i``
+in the relief above, while the vertex itself wears ``J alpha_i`` times its
+relieved penetration (:func:`counter_relief`; the counter-part's own wear is
+extrapolated in :mod:`meshwear.wear`).
 
 A jump is taken as two steps of ``J / 2`` (the second from the penetrations
 the first leaves); the same jump as one step of ``J`` differs from it by
@@ -50,12 +57,15 @@ def contact_geometry(model, body, s, index):
     length = body.area_vectors[index, 3]
     n = len(x)
     depth, normal, area = np.full(n, -np.inf), np.zeros((n, 3)), np.zeros(n)
-    rows = [np.broadcast_to(p[0:2], (n, 2, 3)) for p in model.planes]
-    rows += [vp[index, 0:2] for vp in s.vertex_planes]
-    for row in rows:
+    rows = [(np.broadcast_to(p[0:2], (n, 2, 3)), True) for p in model.planes]
+    # a mesh surface's plane rows are kept for the vertices within reach only
+    # (the others' are stale)
+    reach = np.isin(index, s.active)
+    rows += [(vp[index, 0:2], reach) for vp in s.vertex_planes]
+    for row, valid in rows:
         point, nrm = row[:, 0], row[:, 1]
         projected = -np.einsum("ij,ij->i", world, nrm)
-        facing = projected > FACING * length
+        facing = (projected > FACING * length) & valid
         d = -np.einsum("ij,ij->i", x - point, nrm)
         better = facing & (d > depth)
         depth[better], normal[better], area[better] = d[better], nrm[better], projected[better]
@@ -87,9 +97,13 @@ class BodyJump:
     vertices ``index`` that touched or can touch (the others do not wear)."""
 
     index: np.ndarray        # (k,) int64 the vertices (active, or worn in the cycle)
-    alpha: np.ndarray        # (k,) wear per cycle per unit mean penetration (1 / cycle)
+    alpha: np.ndarray        # (k,) wear per cycle per unit of ``mean`` (1 / cycle)
     depth: np.ndarray        # (k,) penetration at the end of the cycle (m)
-    mean: np.ndarray         # (k,) mean penetration over the cycle (m)
+    mean: np.ndarray         # (k,) penetration while in contact in the cycle (m): the
+                             # force-weighted mean force over the stiffness; 0 untouched
+    now: np.ndarray          # (k,) that penetration as of the end of the cycle (m): ``mean``
+                             # plus half the change of the penetration at the cycle's
+                             # phase over the cycle; the end gap for an untouched vertex
     normal: np.ndarray       # (k, 3) normal of the surface the depth is on (world)
     stiffness: np.ndarray    # (k,) normal stiffness there (N/m)
     member: np.ndarray       # (k,) bool: in the balance (touching at the end, or may)
@@ -99,18 +113,48 @@ class BodyJump:
     guided: bool
     rest: float = 0.0        # the balance without a jump (m): moves are from it
     gamma: np.ndarray = None  # (k,) worn counter-parts' wear under it per cycle per unit
-                              # mean penetration (1 / cycle), or None
+                              # of ``mean`` (1 / cycle), or None
     counter: np.ndarray = None  # (k,) that wear per cycle (m), or None
 
 
-def measure(model, body, s, rate, steps):
-    """The :class:`BodyJump` of ``body`` after a resolved cycle of ``steps``
-    steps in which it wore ``rate`` (n,) (m per cycle)."""
+def start_depths(model, body, s):
+    """(n,) penetration of each vertex within reach of a surface at the
+    start of a cycle (:func:`contact_geometry`; nan for the others), for
+    :func:`measure` at its end."""
+    out = np.full(len(s.wear_depth), np.nan)
+    depth, _, _ = contact_geometry(model, body, s, s.active)
+    out[s.active] = np.where(np.isfinite(depth), depth, np.nan)
+    return out
+
+
+def measure(model, body, s, rate, start=None):
+    """The :class:`BodyJump` of ``body`` after a resolved cycle in which it
+    wore ``rate`` (n,) (m per cycle), ``s.load`` holding the cycle's sums of
+    normal forces and their squares and ``start`` (n,) the penetrations at
+    its start (:func:`start_depths`; None: unknown).
+
+    The penetration while in contact is measured over the cycle, half a
+    cycle before its end, and from each step's force, before that step's
+    wear: the jump starts from it put after the wear and moved on by half
+    its change over the cycle, seen at the same phase (start and end). In a
+    steady contact (a pin, a fretting ball) that is the end penetration; in
+    one that sweeps over the vertex (a gear flank) the kinematics are
+    periodic and only the wear and moves change it."""
     index = np.union1d(s.active, np.flatnonzero(rate > 0.0)).astype(np.int64)
     rate = rate[index]
     depth, normal, stiffness = contact_geometry(model, body, s, index)
-    load = s.load[index]
-    mean = np.where(stiffness > 0.0, load / steps / np.where(stiffness > 0.0, stiffness, 1.0), 0.0)
+    force, square = s.load[0, index], s.load[1, index]
+    # the penetration while in contact: the force-weighted mean force over
+    # the stiffness (the steps out of contact weigh nothing), the one at the
+    # end of the cycle for a vertex pressed then (as its depth is), else that
+    # of its whole area: where a flank out of mesh or a disc's track away
+    # from the pin is at the end, it may face another surface, or none, or
+    # one seen at a slant
+    contact = np.where((depth > 0.0) & (stiffness > 0.0), stiffness,
+                       model.law[5] + model.law[6] * body.area_vectors[index, 3])
+    touching = (contact > 0.0) & (force > 0.0)
+    mean = np.zeros(len(index))
+    mean[touching] = square[touching] / force[touching] / contact[touching]
     wearing = (rate > 0.0) & (mean > 0.0)
     alpha = np.zeros(len(rate))
     alpha[wearing] = rate[wearing] / mean[wearing]
@@ -122,36 +166,53 @@ def measure(model, body, s, rate, steps):
         alpha[fresh] = (rate[wearing] @ area[wearing]) / (mean[wearing] @ area[wearing])
     member = ((depth > 0.0) | fresh) & np.isfinite(depth) & (stiffness > 0.0)
     touched = ~member & (mean > 0.0)
+    # as of the end of the cycle: a step's force is that of the penetration
+    # before its wear, the depths are after it; the force-weighted wear of a
+    # step, rate * sum F^2 / (sum F)^2 (wear in proportion to the force),
+    # puts the mean on the depths' footing (a steady contact's equals its depth)
+    now = np.where(mean > 0.0, mean, np.where(np.isfinite(depth), depth, 0.0))
+    now[touching] -= rate[touching] * square[touching] / force[touching] ** 2
+    if start is not None:
+        change = np.where(np.isfinite(depth), depth, np.nan) - start[index]
+        known = (mean > 0.0) & np.isfinite(change)
+        now[known] += 0.5 * change[known]
     motion = body.motion
     guided = isinstance(motion, (BalancedMotion, GuidedMotion)) and model.slots > 0
     beta, carried = np.zeros(len(rate)), 0.0
     if guided:
-        beta = normal @ motion.axis
+        # a vertex that faces no surface at the end of the cycle was pressed,
+        # while in contact, against its own outward normal
+        facing = np.where(np.any(normal != 0.0, axis=1)[:, None], normal,
+                          -(body.area_vectors[index, 0:3] @ quaternion_matrix(s.pose[3:7]).T)
+                          / np.maximum(body.area_vectors[index, 3:4], 1e-300))
+        beta = facing @ motion.axis
         carried = (motion.carried if isinstance(motion, BalancedMotion)
                 else -float(motion.params[19:22] @ motion.axis) / motion.params[0])
-    m = BodyJump(index, alpha, np.where(np.isfinite(depth), depth, 0.0), mean, normal,
+    m = BodyJump(index, alpha, np.where(np.isfinite(depth), depth, 0.0), mean, now, normal,
                  stiffness, member, touched, beta, carried, guided)
-    m.rest = _step(m, 0.0, m.depth, m.mean)[1]
+    m.rest = _step(m, 0.0, m.depth, m.now)[1]
     return m
 
 
-def _step(m, jump, depth, mean):
-    """One backward-Euler step of ``jump`` cycles from penetrations ``depth``
-    (balance members) and ``mean`` (touched only): (n,) wear, the move z and
-    (n,) the penetration the step takes off (its own and the counter-parts'
-    wear)."""
+def _step(m, jump, depth, now):
+    """One backward-Euler step of ``jump`` cycles from the penetrations at
+    the end of the cycle ``depth`` and while in contact ``now``
+    (:attr:`BodyJump.now`): (n,) wear, the move z and (n,) the penetration
+    the step takes off (its own and the counter-parts' wear)."""
     rate = m.alpha if m.gamma is None else m.alpha + m.gamma
     relief = 1.0 / (1.0 + jump * rate)
     z = 0.0
-    if m.guided:
-        k = m.member
-        z = balance(depth[k], m.beta[k], m.stiffness[k] * relief[k], m.load)
-    # the penetration the step leaves (relieved), for members and touched ones
-    left = np.zeros(len(depth))
     k = m.member
-    left[k] = np.maximum(0.0, depth[k] - m.beta[k] * z) * relief[k]
-    t = m.touched
-    left[t] = mean[t] * relief[t]
+    if m.guided:
+        # a member's end penetration after the step, (ahead - beta z) relief
+        ahead = depth[k] + jump * rate[k] * (depth[k] - now[k])
+        z = balance(ahead, m.beta[k], m.stiffness[k] * relief[k], m.load)
+    # the penetration the step leaves (relieved), for members and touched
+    # ones: the move takes the same off a touched vertex's penetration
+    # (the body sinks as a disc's whole track wears, and presses it again)
+    left = np.zeros(len(depth))
+    k = k | m.touched
+    left[k] = np.maximum(0.0, now[k] - m.beta[k] * z) * relief[k]
     return jump * m.alpha * left, z, jump * rate * left
 
 
@@ -163,10 +224,12 @@ def implicit(m, jump):
     differs from it by about its error (first order: the one step's error is
     twice the two's), as in embedded Runge-Kutta pairs that advance with the
     better of the two."""
-    whole, _, _ = _step(m, jump, m.depth, m.mean)
-    half, z1, taken = _step(m, 0.5 * jump, m.depth, m.mean)
-    rest, z2, _ = _step(m, 0.5 * jump, m.depth - m.beta * z1 - taken,
-                        np.maximum(0.0, m.mean - taken))
+    whole, _, _ = _step(m, jump, m.depth, m.now)
+    half, z1, taken = _step(m, 0.5 * jump, m.depth, m.now)
+    # the move and the wear take the same off the penetration at every step
+    # in contact
+    shift = m.beta * z1 + taken
+    rest, z2, _ = _step(m, 0.5 * jump, m.depth - m.beta * z1 - taken, m.now - shift)
     wear = half + rest
     return wear, z1 + z2 - m.rest, np.abs(whole - wear)
 

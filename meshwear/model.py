@@ -171,9 +171,10 @@ class BodyState:
     active_wear: np.ndarray = None
     cull: np.ndarray = None
     cull_scratch: object = None
-    #: (n,) each vertex's total normal force added up over the steps since
-    #: it was last zeroed (N), kept while cycles are jumped over; else empty
-    load: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: (2, n) each vertex's total normal force (N) and total squared normal
+    #: force (N²) added up over the steps since they were last zeroed, kept
+    #: while cycles are jumped over; else (2, 0)
+    load: np.ndarray = field(default_factory=lambda: np.zeros((2, 0)))
 
 
 @dataclass(eq=False)

@@ -82,12 +82,14 @@ def finish_step(model, body, s, t):
 
 
 def touch(model, body, s, t):
-    """One step of the contact kernel at ``t``, the normal forces added to
-    ``s.load`` if kept, and the wear of worn counter-surfaces."""
+    """One step of the contact kernel at ``t``, the normal forces and their
+    squares added to ``s.load`` if kept, and the wear of worn counter-surfaces."""
     body_contact(model, body, s)
-    if len(s.load):
+    if s.load.shape[1]:
         a = s.active
-        s.load[a] += s.normal_force[:, a].sum(axis=0)
+        force = s.normal_force[:, a].sum(axis=0)
+        s.load[0, a] += force
+        s.load[1, a] += force * force
     if model.worn_counters:
         too_deep = wear_counters(model, body, s, t)
         if too_deep is not None:

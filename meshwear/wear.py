@@ -149,13 +149,18 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
                                part_error=[np.zeros(len(p.depth)) for _, p in parts])
     js = state.jump
     for body, s in zip(model.bodies, state.bodies):
-        if len(s.load) != len(s.wear_depth):
-            s.load = np.zeros(len(s.wear_depth))
+        if s.load.shape[1] != len(s.wear_depth):
+            s.load = np.zeros((2, len(s.wear_depth)))
     while state.step < model.n_steps:
         start = state.step
         before = [(s.wear_depth.copy(), s.vertices.copy(), s.wear_volume.copy(),
                    s.friction_work.copy()) for s in state.bodies]
         before_parts = [(p.depth.copy(), p.volume.copy(), p.work.copy()) for _, p in parts]
+        # the penetrations at the cycle's start, to see each one's change at
+        # the same phase (the state at t = 0 is not yet placed in balance)
+        starts = ([jumps.start_depths(model, body, s) for body, s in zip(model.bodies,
+                                                                          state.bodies)]
+                  if implicit and start > 0 else [None] * len(model.bodies))
         for s in state.bodies:
             s.load[:] = 0.0
         stop = min(start + n_c, model.n_steps)
@@ -174,8 +179,8 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
             continue
         rates = [s.wear_depth - b[0] for s, b in zip(state.bodies, before)]
         part_rates = [p.depth - b[0] for (_, p), b in zip(parts, before_parts)]
-        measures = ([jumps.measure(model, body, s, rate, stop - start)
-                     for body, s, rate in zip(model.bodies, state.bodies, rates)]
+        measures = ([jumps.measure(model, body, s, rate, start)
+                     for body, s, rate, start in zip(model.bodies, state.bodies, rates, starts)]
                     if implicit else None)
         part_limit, part_which = float("inf"), None
         if parts:

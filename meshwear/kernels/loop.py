@@ -17,8 +17,9 @@ body
     ``vertices, pose, area, law, wear_direction, contact_state, tangential,
     normal_force, friction_work, wear_depth, wear_volume, wrench,
     vertex_planes, hint, active, active_wear, cull, distance, load`` (the
-    arrays of :class:`meshwear.model.BodyState` and its model; ``load`` (n,)
-    adds up each vertex's total normal force over the steps, or is empty) and
+    arrays of :class:`meshwear.model.BodyState` and its model; ``load`` (2, n)
+    adds up each vertex's total normal force and its square over the steps,
+    or is (2, 0)) and
     ``radius`` (m).
 motion
     ``kind`` and ``params`` (:mod:`meshwear.kernels.rigid`), the path
@@ -67,7 +68,8 @@ def _fill(body, planes, surfaces, t, buffer, rotation, frame):
 
 @njit(cache=True)
 def _touch(body, plane_array):
-    """One step of the contact kernel; the normal forces added to ``load``."""
+    """One step of the contact kernel; the normal forces and their squares
+    added to ``load``."""
     (vertices, pose, area, law, wear_direction, contact_state, tangential, normal_force,
      friction_work, wear_depth, wear_volume, wrench, vertex_planes, hint, active, active_wear,
      cull, distance, load, radius) = body
@@ -80,13 +82,14 @@ def _touch(body, plane_array):
         contact_serial(vertices, pose, plane_array, vertex_planes, active, area, law,
                        wear_direction, contact_state, tangential, normal_force, friction_work,
                        wear_depth, wear_volume, wrench)
-    if load.shape[0]:
+    if load.shape[1]:
         for k in range(active.shape[0]):
             i = active[k]
             total = 0.0
             for s in range(slots):
                 total += normal_force[s, i]
-            load[i] += total
+            load[0, i] += total
+            load[1, i] += total * total
 
 
 @njit(cache=True)
