@@ -23,9 +23,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .kernels.laws import LAWS
-from .scene_checks import (SceneError, _boolean, _choice, _did_you_mean, _direction, _exclusive,
-                           _instance, _integer, _name, _nonnegative, _positive, _real, _set,
-                           _set_optional, _show, _vector)
+from .scene_checks import (SceneError, _boolean, _choice, _coefficient, _did_you_mean,
+                           _direction, _exclusive, _instance, _integer, _name, _nonnegative,
+                           _positive, _real, _set, _set_optional, _show, _vector,
+                           winkler_stiffness)
 
 FORMAT = 1
 MODES = ("dynamic", "quasi-static")
@@ -128,9 +129,17 @@ class ContactConfig:
     #: m: vertices farther than this from every surface are skipped (active
     #: set); None: 1 % of each body's bounding-box diagonal
     margin: float | None = None
+    #: ``{youngs_modulus, poissons_ratio, thickness}``: the normal stiffness
+    #: per area of an elastic layer (a Winkler foundation), instead of giving it
+    layer: dict | None = None
 
     def __post_init__(self):
         _set_optional(self, "margin", _positive)
+        if self.layer is not None:
+            for other in ("stiffness", "stiffness_per_area"):
+                if getattr(self, other) is not None:
+                    raise SceneError("", "layer", f"give either layer or {other}, not both")
+            object.__setattr__(self, "stiffness_per_area", winkler_stiffness("layer", self.layer))
         for base, check in (("stiffness", _positive), ("damping", _nonnegative),
                             ("tangential_stiffness", _positive), ("tangential_damping", _nonnegative)):
             _exclusive(self, base, base + "_per_area")
@@ -172,7 +181,8 @@ class WearConfig:
     """
 
     law: str = "energy"
-    coefficient: float = 1e-9
+    #: in the law's SI unit, or ``"<number> <unit>"`` (``"2e-6 mm3/(N m)"``)
+    coefficient: float | str = 1e-9
     direction: str = "contact_normal"
     acceleration: str = "none"
     period: float | None = None
@@ -181,7 +191,7 @@ class WearConfig:
 
     def __post_init__(self):
         _set(self, "law", _choice, tuple(LAWS))
-        _set(self, "coefficient", _nonnegative)
+        _set(self, "coefficient", _coefficient, LAWS[self.law].unit)
         _set(self, "direction", _choice, WEAR_DIRECTIONS)
         _set(self, "acceleration", _choice, ACCELERATIONS)
         _set(self, "jump", _choice, JUMPS)
@@ -399,7 +409,7 @@ class SurfaceConfig:
     #: the [wear] ones, filled in by the Scene)
     wear: bool = False
     law: str | None = None
-    coefficient: float | None = None
+    coefficient: float | str | None = None
 
     def __post_init__(self):
         _set(self, "name", _name)
@@ -422,7 +432,10 @@ class SurfaceConfig:
             _check_mesh_or_shape(self)
             _set(self, "wear", _boolean)
             _set_optional(self, "law", _choice, tuple(LAWS))
-            _set_optional(self, "coefficient", _nonnegative)
+            if self.law is not None or not isinstance(self.coefficient, str):
+                # with units and no law of its own, the scene checks it against [wear]'s
+                _set_optional(self, "coefficient", _coefficient,
+                              LAWS[self.law or "archard"].unit)
             for key in ("law", "coefficient"):
                 if getattr(self, key) is not None and not self.wear:
                     raise SceneError("", key, "applies to a worn surface only; "
@@ -495,6 +508,16 @@ class Scene:
         object.__setattr__(self, "base_dir", Path(self.base_dir))
         object.__setattr__(self, "bodies", tuple(self.bodies))
         object.__setattr__(self, "surfaces", tuple(self.surfaces))
+        # a worn surface's coefficient with units and [wear]'s law
+        surfaces = list(self.surfaces)
+        for j, s in enumerate(surfaces):
+            if isinstance(s, SurfaceConfig) and isinstance(s.coefficient, str):
+                try:
+                    value = _coefficient("coefficient", s.coefficient, LAWS[self.wear.law].unit)
+                except SceneError as err:
+                    fail(f"surface[{j}].{err.key}", err.message)
+                surfaces[j] = dataclasses.replace(s, coefficient=value)
+        object.__setattr__(self, "surfaces", tuple(surfaces))
         if not self.bodies:
             fail("body", "no bodies; add at least one [[body]] table")
         items = ([(f"body[{i}]", b, BodyConfig) for i, b in enumerate(self.bodies)]

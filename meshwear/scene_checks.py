@@ -152,3 +152,75 @@ def _set_optional(obj, name, check, *args):
 def _exclusive(obj, a, b):
     if getattr(obj, a) is not None and getattr(obj, b) is not None:
         raise SceneError("", b, f"give either {a} or {b}, not both")
+
+
+#: units a wear coefficient may be written in, as ``"<number> <unit>"``: the
+#: factor to SI and the SI unit (1/Pa = m³/(N·m) = m³/J: Archard's and the
+#: volume energy law's; m/J: the depth energy law's)
+COEFFICIENT_UNITS = {
+    "1/Pa": (1.0, "m³/J"), "m3/J": (1.0, "m³/J"), "m3/(N m)": (1.0, "m³/J"),
+    "mm3/J": (1e-9, "m³/J"), "mm3/(N m)": (1e-9, "m³/J"),
+    "m/J": (1.0, "m/J"), "mm/J": (1e-3, "m/J"), "um/J": (1e-6, "m/J"),
+}
+#: the SI unit of each law's coefficient, as COEFFICIENT_UNITS names it
+LAW_DIMENSIONS = {"1/Pa": "m³/J", "m³/J": "m³/J", "m/J": "m/J"}
+
+
+def _unit_text(unit):
+    """A unit's spelling normalised: ``mm^3/(N*m)``, ``mm³/(N·m)`` and
+    ``mm3/Nm`` are ``mm3/(N m)``; ``µm/J`` is ``um/J``."""
+    text = unit.strip().replace("³", "3").replace("^3", "3").replace("µ", "u").replace("μ", "u")
+    text = re.sub(r"\s*[*·]\s*", " ", text).replace("(Nm)", "(N m)").replace("/Nm", "/(N m)")
+    text = re.sub(r"/N m$", "/(N m)", text)
+    return re.sub(r"\s+", " ", text)
+
+
+def _coefficient(key, value, law_unit):
+    """A wear coefficient (>= 0) in SI: a number, or ``"<number> <unit>"``
+    with a unit of :data:`COEFFICIENT_UNITS` that fits the law's
+    (``law_unit``, the law's :attr:`~meshwear.kernels.laws.WearLaw.unit`)."""
+    if not isinstance(value, str):
+        return _nonnegative(key, value)
+    number, _, unit = value.strip().partition(" ")
+    try:
+        number = float(number)
+    except ValueError:
+        raise SceneError("", key, f'expected a number or "<number> <unit>" such as '
+                                  f'"2e-6 mm3/(N m)", got {_show(value)}') from None
+    spelled = _unit_text(unit)
+    if spelled not in COEFFICIENT_UNITS:
+        raise SceneError("", key, f"unknown unit {unit.strip()!r}; one of "
+                                  f"{', '.join(COEFFICIENT_UNITS)}")
+    factor, dimension = COEFFICIENT_UNITS[spelled]
+    wanted = LAW_DIMENSIONS[law_unit]
+    if dimension != wanted:
+        raise SceneError("", key, f"{unit.strip()!r} is a {dimension} unit; this law's "
+                                  f"coefficient is in {law_unit}")
+    return _nonnegative(key, number * factor)
+
+
+def winkler_stiffness(key, layer):
+    """Normal stiffness per area (N/m³) of an elastic layer on a rigid base,
+    ``{youngs_modulus, poissons_ratio = 0.3, thickness}`` (Pa, -, m): its
+    constrained modulus over its thickness, E (1 - nu) / ((1 + nu)(1 - 2 nu) h)
+    (the Winkler foundation of a thin layer; docs/scene-format.md)."""
+    if not isinstance(layer, dict):
+        raise SceneError("", key, f"expected a table {{ youngs_modulus, poissons_ratio, "
+                                  f"thickness }}, got {_show(layer)}")
+    unknown = set(layer) - {"youngs_modulus", "poissons_ratio", "thickness"}
+    if unknown:
+        raise SceneError("", f"{key}.{sorted(unknown)[0]}", "unknown key (expected "
+                         "youngs_modulus, poissons_ratio, thickness)")
+    for name in ("youngs_modulus", "thickness"):
+        if name not in layer:
+            raise SceneError("", f"{key}.{name}", "missing")
+    E = _positive(f"{key}.youngs_modulus", layer["youngs_modulus"])
+    h = _positive(f"{key}.thickness", layer["thickness"])
+    nu = _real(f"{key}.poissons_ratio", layer.get("poissons_ratio", 0.3))
+    if not 0.0 <= nu < 0.5:
+        raise SceneError("", f"{key}.poissons_ratio", f"must be in [0, 0.5), got {nu!r}")
+    value = E * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu) * h)
+    if not math.isfinite(value):
+        raise SceneError("", key, f"the stiffness E (1 - nu) / ((1 + nu)(1 - 2 nu) h) "
+                                  f"overflows ({_show(layer)})")
+    return value

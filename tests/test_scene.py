@@ -4,6 +4,7 @@ documented defaults; bad input raises one SceneError line naming file and key.""
 import dataclasses
 import math
 import pickle
+from pathlib import Path
 
 import pytest
 
@@ -404,3 +405,107 @@ def test_scene_checks_names_and_bodies_when_built_directly():
         Scene(format=1, bodies=(body,), surfaces=(SurfaceConfig(name="b"),))
     with pytest.raises(SceneError, match="format"):
         Scene(format=2, bodies=(body,))
+
+
+_EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+@pytest.mark.parametrize("path", sorted(_EXAMPLES.rglob("*.toml")), ids=lambda p: p.stem)
+def test_every_example_scene_is_valid_and_its_meshes_exist(path):
+    scene = load_scene(path)
+    for item in scene.bodies + scene.surfaces:
+        mesh = getattr(item, "mesh", None)
+        if mesh is not None:
+            assert Path(mesh).is_file(), f"{path.name}: {mesh} is missing"
+
+
+UNITS_SCENE = """
+format = 1
+[contact]
+{contact}
+[wear]
+law = "{law}"
+coefficient = {coefficient}
+[[body]]
+name = "b"
+shape = {{ type = "box", size = [0.01, 0.01, 0.01] }}
+[[surface]]
+name = "s"
+type = "mesh"
+shape = {{ type = "box", size = [0.02, 0.02, 0.002] }}
+wear = true
+{surface}
+"""
+
+
+def _units_scene(tmp_path, law="archard", coefficient="1e-13", contact="", surface=""):
+    path = tmp_path / "units.toml"
+    path.write_text(UNITS_SCENE.format(law=law, coefficient=coefficient, contact=contact,
+                                       surface=surface))
+    return load_scene(path)
+
+
+@pytest.mark.parametrize("law, text, si", [
+    ("archard", '"2e-6 mm3/(N m)"', 2e-15),
+    ("archard", '"2e-6 mm^3/(N*m)"', 2e-15),
+    ("archard", '"2e-6 mm³/(N·m)"', 2e-15),
+    ("archard", '"2e-6 mm3/Nm"', 2e-15),
+    ("archard", '"3e-15 1/Pa"', 3e-15),
+    ("energy_density", '"1e-5 mm3/J"', 1e-14),
+    ("energy", '"4 um/J"', 4e-6),
+    ("energy", "4e-6", 4e-6),
+])
+def test_a_wear_coefficient_may_carry_its_unit(tmp_path, law, text, si):
+    scene = _units_scene(tmp_path, law, text)
+    assert scene.wear.coefficient == pytest.approx(si, rel=1e-12)
+    assert isinstance(scene.wear.coefficient, float)
+
+
+def test_a_worn_surface_s_coefficient_with_units_follows_the_law(tmp_path):
+    inherited = _units_scene(tmp_path, surface='coefficient = "5e-6 mm3/(N m)"')
+    assert inherited.surfaces[0].coefficient == pytest.approx(5e-15, rel=1e-12)
+    own = _units_scene(tmp_path, surface='law = "energy"\ncoefficient = "2 mm/J"')
+    assert own.surfaces[0].coefficient == pytest.approx(2e-3, rel=1e-12)
+    with pytest.raises(SceneError, match=r"surface\[0\]\.coefficient: 'mm/J' is a m/J unit"):
+        _units_scene(tmp_path, surface='coefficient = "2 mm/J"')
+
+
+@pytest.mark.parametrize("law, text, message", [
+    ("archard", '"2e-6 mm/J"', "'mm/J' is a m/J unit; this law's coefficient is in 1/Pa"),
+    ("energy", '"2e-6 mm3/J"', "'mm3/J' is a m³/J unit"),
+    ("archard", '"2e-6 furlongs"', "unknown unit 'furlongs'"),
+    ("archard", '"lots"', "expected a number or"),
+    ("archard", '"-1 mm3/(N m)"', "must be >= 0"),
+])
+def test_bad_coefficient_units_are_refused_naming_the_key(tmp_path, law, text, message):
+    with pytest.raises(SceneError, match="wear.coefficient") as err:
+        _units_scene(tmp_path, law, text)
+    assert message in str(err.value)
+
+
+def test_a_layer_gives_the_winkler_modulus(tmp_path):
+    scene = _units_scene(tmp_path, contact="layer = { youngs_modulus = 2.1e11, "
+                                           "poissons_ratio = 0.3, thickness = 1e-3 }")
+    E, nu, h = 2.1e11, 0.3, 1e-3
+    assert scene.contact.stiffness_per_area == pytest.approx(
+        E * (1 - nu) / ((1 + nu) * (1 - 2 * nu) * h), rel=1e-12)
+    assert scene.contact.stiffness is None
+    # Poisson's ratio 0.3 unless given
+    plain = _units_scene(tmp_path, contact="layer = { youngs_modulus = 2.1e11, thickness = 1e-3 }")
+    assert plain.contact.stiffness_per_area == scene.contact.stiffness_per_area
+
+
+@pytest.mark.parametrize("layer, key", [
+    ("layer = { youngs_modulus = 2.1e11 }", "contact.layer.thickness"),
+    ("layer = { youngs_modulus = -1.0, thickness = 1e-3 }", "contact.layer.youngs_modulus"),
+    ("layer = { youngs_modulus = 1e9, thickness = 1e-3, poissons_ratio = 0.5 }",
+     "contact.layer.poissons_ratio"),
+    ("layer = { youngs_modulus = 1e9, thickness = 1e-3, nu = 0.3 }", "contact.layer.nu"),
+    ("layer = 3.0", "contact.layer"),
+    ("stiffness_per_area = 1e13\nlayer = { youngs_modulus = 1e9, thickness = 1e-3 }",
+     "contact.layer"),
+])
+def test_bad_layers_are_refused_naming_the_key(tmp_path, layer, key):
+    with pytest.raises(SceneError) as err:
+        _units_scene(tmp_path, contact=layer)
+    assert err.value.key == key
