@@ -10,18 +10,19 @@ cycle, a pin's, or for a few steps of it, a gear flank's). Wear and a move
 penetration at every step it touches, so a jump of ``J`` cycles solves,
 backward Euler,
 
-    w_i = J alpha_i (pbar_i - beta_i z - w_i)_+,    sum_i c_i beta_i (p_i - beta_i z - w_i)_+ = L,
+    w_i = J alpha_i (phat_i - beta_i z - w_i)_+,    sum_i c_i beta_i (p_i - beta_i z - w_i)_+ = L,
 
 ``p_i`` the penetration at the end of the cycle on the surface nearest the
-vertex, ``beta_i`` the free axis along its normal, ``L`` the load: each
-vertex wears ``J alpha_i (pbar_i - beta_i z) / (1 + J alpha_i)`` (at most
-its penetration, whatever ``J``), its end penetration becomes
-``(p_i + J alpha_i (p_i - pbar_i) - beta_i z) / (1 + J alpha_i)`` and ``z`` is
+vertex, ``phat_i`` its penetration while in contact as of the end of the
+cycle (:func:`measure`), ``beta_i`` the free axis along its normal, ``L``
+the load: each vertex wears ``J alpha_i (phat_i - beta_i z) / (1 + J
+alpha_i)`` (at most its penetration, whatever ``J``), its end penetration
+becomes ``(p_i + J alpha_i (p_i - phat_i) - beta_i z) / (1 + J alpha_i)`` and ``z`` is
 a 1-D monotone solve (:func:`balance`). A vertex touched during the cycle
 but not at its end wears alike but does not take part in the balance (its
-normal, if it faces no surface then, is its own). A vertex out of contact that the move
-brings in wears as the contact does on average per unit penetration, from
-its gap at the end of the cycle.
+normal, if it faces no surface then, is its own). A vertex out of contact
+that the move brings in wears as the contact does on average per unit
+penetration, from its gap at the end of the cycle.
 
 A worn counter-part relieves a vertex too: the counter's wear under it in
 the cycle, ``r_c,i = gamma_i pbar_i`` (linear in the pressure alike), takes

@@ -29,8 +29,6 @@ MODES = ("grid", "list")
 FIGURES = ("wear_volume", "max_wear_depth", "friction_work")
 #: a finished run's record in its folder
 RECORD = "sweep_run.json"
-#: rows and statuses
-STATUSES = ("ok", "bad_input", "numerical_error", "failed")
 
 
 @dataclass(frozen=True)
