@@ -189,16 +189,16 @@ def run(scene, *, out=None, progress=None, vertex_history=False, check_dt=True):
     totals = summary(model, state, time.perf_counter() - start)
     if recorder is not None:
         recorder.close(totals)
-    return Result(scene=scene, parts=_parts(model, state, columns), history=columns.table(),
+    table = columns.table()
+    return Result(scene=scene, parts=_parts(model, state, columns, table), history=table,
                   summary=totals, out=Path(out) if out is not None else None, model=model,
                   state=state)
 
 
-def _parts(model, state, columns):
+def _parts(model, state, columns, table):
     from .output.fields import body_quantities, part_quantities
     from .output.recorder import FIELDS
 
-    table = columns.table()
     names = table.get("body", np.array([], dtype=object))
     parts = {}
     for body, s in zip(model.bodies, state.bodies):

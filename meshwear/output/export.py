@@ -46,6 +46,20 @@ def worn_parts(out_dir):
     return names
 
 
+def chosen_parts(out_dir, names):
+    """``names`` (default: every worn part of ``out_dir``), each checked to
+    be one of them (ExportError naming ``--part``)."""
+    available = worn_parts(out_dir)
+    if not available:
+        raise ExportError(f"{out_dir}: no worn part's series here (a meshwear run's folder?)")
+    names = list(names) if names else available
+    for name in names:
+        if name not in available:
+            raise ExportError(f"--part {name}: not a worn part of {out_dir} "
+                              f"(there: {', '.join(available)})")
+    return names
+
+
 def part_mesh(out_dir, name, frame=-1):
     """The worn mesh of part ``name`` at frame number ``frame`` (negative:
     from the end), in its own frame.
@@ -91,14 +105,7 @@ def export(out_dir, names=None, frame=-1, fmt="stl", units="m", dest=None):
         raise ExportError(f"--format {fmt}: expected one of {', '.join(FORMATS)}")
     if units not in UNITS:
         raise ExportError(f"--units {units}: expected one of {', '.join(UNITS)}")
-    available = worn_parts(out_dir)
-    if not available:
-        raise ExportError(f"{out_dir}: no worn part's series here (a meshwear run's folder?)")
-    names = list(names) if names else available
-    for name in names:
-        if name not in available:
-            raise ExportError(f"--part {name}: not a worn part of {out_dir} "
-                              f"(there: {', '.join(available)})")
+    names = chosen_parts(out_dir, names)
     dest = Path(dest) if dest is not None else out_dir
     dest.mkdir(parents=True, exist_ok=True)
     written = []

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .export import ExportError, part_mesh, series_frames, worn_parts
+from .export import ExportError, chosen_parts, part_mesh, series_frames
 
 #: pixels of the wear maps
 MAP_SIZE = (900, 700)
@@ -56,14 +56,7 @@ def plot(out_dir, names=None, dest=None, profile=None):
         dest = Path(dest) if dest is not None else out_dir / "plots"
         dest.mkdir(parents=True, exist_ok=True)
         return [sweep_plot(out_dir / "sweep.csv", dest / "sweep.png", plt)]
-    available = worn_parts(out_dir)
-    if not available:
-        raise ExportError(f"{out_dir}: no worn part's series here (a meshwear run's folder?)")
-    names = list(names) if names else available
-    for name in names:
-        if name not in available:
-            raise ExportError(f"--part {name}: not a worn part of {out_dir} "
-                              f"(there: {', '.join(available)})")
+    names = chosen_parts(out_dir, names)
     if profile is not None:
         _line(profile)
     if profile is not None and len(names) > 1:
