@@ -16,6 +16,14 @@ log = logging.getLogger(__name__)
 #: file extensions read by trimesh; anything else goes to meshio (Gmsh .msh,
 #: Abaqus .inp, VTK .vtu/.vtk, ...)
 TRIMESH_FORMATS = {".stl", ".obj", ".ply", ".off", ".glb", ".gltf", ".3mf", ".dae", ".stl_ascii"}
+#: CAD files read by trimesh through cascadio (OpenCASCADE), the ``cad`` extra
+STEP_FORMATS = {".step", ".stp"}
+#: tessellation of STEP surfaces: chord error relative to each edge's length and
+#: angle between neighbouring facets' normals (rad), about 60 facets round a circle
+STEP_LINEAR_TOLERANCE = 1e-3
+STEP_ANGULAR_TOLERANCE = 0.1
+#: how to install the STEP reader, named by the error when it is missing
+CAD_EXTRA = "pip install 'meshwear[cad]'"
 #: metres per unit of a mesh file
 UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "in": 0.0254}
 
@@ -37,7 +45,11 @@ def _arrays(vertices, faces):
 # ---------------------------------------------------------------- loading
 
 def load_mesh(path, units="m"):
-    """Read a triangle mesh file (STL, OBJ, PLY, OFF, GLB, ...) in metres, cleaned.
+    """Read a triangle mesh file (STL, OBJ, PLY, OFF, GLB, STEP, ...) in metres, cleaned.
+
+    STEP files carry their own length unit and are tessellated by OpenCASCADE
+    (through trimesh and cascadio, the ``cad`` extra) into metres; their
+    ``units`` must be left at ``"m"``.
 
     Parameters
     ----------
@@ -54,7 +66,8 @@ def load_mesh(path, units="m"):
     Raises
     ------
     MeshError
-        Unknown units, unreadable file, no faces, non-finite vertices.
+        Unknown units, unreadable file, no faces, non-finite vertices, a STEP
+        file without the ``cad`` extra installed.
     """
     path = Path(path)
     if not isinstance(units, str) or units not in UNITS:
@@ -62,8 +75,14 @@ def load_mesh(path, units="m"):
     scale = UNITS[units]
     if not path.is_file():
         raise MeshError(f"{path}: {_not_a_file(path)}")
+    suffix = path.suffix.lower()
+    if suffix in STEP_FORMATS and units != "m":
+        raise MeshError(f"{path}: units {units!r}: a STEP file carries its own length unit "
+                        "(read in metres); leave units out")
     try:
-        if path.suffix.lower() in TRIMESH_FORMATS:
+        if suffix in STEP_FORMATS:
+            vertices, faces = _read_step(path)
+        elif suffix in TRIMESH_FORMATS:
             vertices, faces = _read_trimesh(path)
         else:
             vertices, faces = _read_meshio(path)
@@ -98,6 +117,22 @@ def _read_trimesh(path):
     import trimesh
 
     mesh = trimesh.load(str(path), force="mesh", process=False)
+    return (np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64),
+            np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64))
+
+
+def _read_step(path):
+    """Triangles of a STEP file's solids, tessellated by OpenCASCADE, in metres."""
+    try:
+        import cascadio  # noqa: F401  (trimesh's STEP loader needs it)
+    except ImportError:
+        raise MeshError(f"{path}: reading STEP files needs the optional cad extra: "
+                        f"{CAD_EXTRA}") from None
+    import trimesh
+
+    mesh = trimesh.load(str(path), file_type="step", force="mesh", process=False,
+                        tol_linear=STEP_LINEAR_TOLERANCE, tol_relative=True,
+                        tol_angular=STEP_ANGULAR_TOLERANCE)
     return (np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64),
             np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64))
 

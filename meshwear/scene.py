@@ -34,6 +34,8 @@ WEAR_DIRECTIONS = ("contact_normal", "vertex_normal")
 ACCELERATIONS = ("none", "cycle_jump")
 JUMPS = ("implicit", "explicit")
 UNITS = ("m", "mm", "cm", "um", "in")
+#: mesh files that state their own length unit (geometry.STEP_FORMATS)
+STEP_FORMATS = (".step", ".stp")
 MOTIONS = ("free", "guided", "prescribed", "fixed")
 SURFACE_TYPES = ("plane", "mesh", "cylinder", "sphere")
 SIDES = ("outside", "inside")
@@ -71,6 +73,8 @@ def _check_mesh_or_shape(obj):
     _set(obj, "units", _choice, UNITS)
     if obj.shape is not None and obj.units != "m":
         raise SceneError("", "units", "applies to mesh files only; shape dimensions are in metres")
+    if obj.mesh is not None and obj.mesh.suffix.lower() in STEP_FORMATS and obj.units != "m":
+        raise SceneError("", "units", "a STEP file carries its own length unit; leave units out")
     _set_optional(obj, "resolution", _positive)
     _set(obj, "position", _vector)
     _set(obj, "orientation", _direction, 4)
