@@ -20,6 +20,10 @@ from .scene import SceneError
 
 #: fraction of the estimated stability limit accepted as the largest stable dt
 STABILITY_MARGIN = 0.9
+#: ``run.dt = "auto"`` resolves a cycle of the motion into at least this many steps
+AUTO_STEPS_PER_CYCLE = 200
+#: ... and the whole run into at least this many
+AUTO_STEPS_PER_RUN = 1000
 
 
 @dataclass(frozen=True, eq=False)
@@ -256,17 +260,6 @@ def build_model(scene):
     plane_array = surface_set.planes
 
     run = scene.run
-    n_steps = max(1, int(np.ceil(run.duration / run.dt - 1e-9)))
-    dt = run.duration / n_steps
-    cycle_steps = 0
-    if scene.wear.acceleration == "cycle_jump":
-        cycle_steps, dt, n_steps = _cycle_timing(scene)
-    for key in ("frames", "history"):
-        if getattr(run, key) > n_steps + 1:
-            # a short run (a trial, a --set run.duration) writes at every step
-            logging.getLogger("meshwear").warning(
-                "%s: run.%s: %d asked, but the run has %d step times (duration / dt + 1): "
-                "writing one at each", scene.source, key, getattr(run, key), n_steps + 1)
     bodies = []
     for j, b in enumerate(scene.bodies):
         try:
@@ -279,7 +272,7 @@ def build_model(scene):
     c = scene.contact
     (ct, ct_area), (dt_point, dt_area) = c.tangential
     law = make_law(friction=c.friction, static_friction=c.static_friction,
-                   wear_law=scene.wear.law, wear_coefficient=scene.wear.coefficient, dt=dt,
+                   wear_law=scene.wear.law, wear_coefficient=scene.wear.coefficient, dt=0.0,
                    stiffness=c.stiffness or 0.0, stiffness_per_area=c.stiffness_per_area or 0.0,
                    damping=c.damping or 0.0, damping_per_area=c.damping_per_area or 0.0,
                    tangential_stiffness=ct or 0.0, tangential_stiffness_per_area=ct_area or 0.0,
@@ -308,6 +301,16 @@ def build_model(scene):
     surface_set.refresh_bounds()
     periods = _periods(scene)
     period = scene.wear.period or (max(periods) if periods else None)
+    slots = plane_array.shape[0] + len(surface_set.per_vertex)
+    limit = _stable_limit(bodies, law, slots)[0]
+    dt, n_steps, cycle_steps = _timing(scene, period, limit)
+    law[LAW_SLOTS.index("dt")] = dt
+    for key in ("frames", "history"):
+        if getattr(run, key) > n_steps + 1:
+            # a short run (a trial, a --set run.duration) writes at every step
+            logging.getLogger("meshwear").warning(
+                "%s: run.%s: %d asked, but the run has %d step times (duration / dt + 1): "
+                "writing one at each", scene.source, key, getattr(run, key), n_steps + 1)
     # unbounded surfaces (a plane without a size) are drawn 4 body extents wide
     extent = 4.0 * max(float(np.ptp(b.reference_vertices, axis=0).max()) for b in bodies)
     return Model(scene=scene, bodies=bodies, planes=plane_array, law=law, extent=extent,
@@ -327,19 +330,38 @@ def _periods(scene):
     return [p for p in out if p is not None]
 
 
-def _cycle_timing(scene):
-    """Steps per cycle, dt and steps of a cycle-jumping run: dt is adjusted so
-    a cycle is a whole number of steps, and the duration rounded to whole steps."""
+def auto_time_step(scene, period, limit):
+    """The step ``run.dt = "auto"`` stands for (s): the largest stable step
+    ``limit`` of the bodies integrated in time, and no longer than a
+    :data:`AUTO_STEPS_PER_CYCLE`-th of the motion's cycle ``period`` (None
+    when nothing moves periodically) or a :data:`AUTO_STEPS_PER_RUN`-th of
+    the duration."""
+    step = scene.run.duration / AUTO_STEPS_PER_RUN
+    if period is not None:
+        step = min(step, period / AUTO_STEPS_PER_CYCLE)
+    return min(step, limit)
+
+
+def _timing(scene, period, limit):
+    """``(dt, n_steps, cycle_steps)`` of a run: the step asked (or
+    :func:`auto_time_step`) shortened so the duration is whole steps; when
+    cycles are jumped over, so a cycle is whole steps (``cycle_steps``, else
+    0) and the duration whole cycles' steps. Never longer than asked."""
+    asked = scene.run.dt
+    if asked == "auto":
+        asked = auto_time_step(scene, period, limit)
+    if scene.wear.acceleration != "cycle_jump":
+        n_steps = max(1, int(np.ceil(scene.run.duration / asked - 1e-9)))
+        return scene.run.duration / n_steps, n_steps, 0
     for j, b in enumerate(scene.bodies):
         if b.motion == "free":
             raise SceneError(scene.source, f"body[{j}].motion", "'free' bodies have no cycle to "
                              "jump over; wear.acceleration = 'cycle_jump' needs guided, "
                              "prescribed or fixed bodies")
-    period = scene.wear.period or max(_periods(scene))
-    cycle_steps = max(1, int(round(period / scene.run.dt)))
+    cycle_steps = max(1, int(np.ceil(period / asked - 1e-9)))
     dt = period / cycle_steps
     n_steps = max(1, int(round(scene.run.duration / dt)))
-    return cycle_steps, dt, n_steps
+    return dt, n_steps, cycle_steps
 
 
 def _even_steps(n_steps, count):
@@ -458,14 +480,6 @@ def _refuse_deep_start(scene, index, body, config, surface_set, vertex_planes):
                              "and a mesh's face normals, point out of the solid side)")
 
 
-def point_coefficients(model, body):
-    """Largest per-vertex ``c, d, c_t, d_t`` (n,) of ``body`` over all plane
-    orientations (N/m, N·s/m): per-area coefficients at the full length of
-    the area vector."""
-    a = body.area_vectors[:, 3]
-    return tuple(model.law[5 + 2 * j] + model.law[6 + 2 * j] * a for j in range(4))  # LAW_SLOTS
-
-
 def initial_state(model):
     """Allocate the :class:`State` of ``model`` at t = 0, with each body's
     active set."""
@@ -539,14 +553,21 @@ def stable_time_step(model):
     times :data:`STABILITY_MARGIN`. Returns ``(inf, None)`` when no body is
     integrated in time.
     """
+    return _stable_limit(model.bodies, model.law, model.slots)
+
+
+def _stable_limit(bodies, law, slots):
+    """:func:`stable_time_step` of ``bodies`` under the contact ``law`` with
+    ``slots`` counter-surfaces."""
     best, who = np.inf, None
-    for b in model.bodies:
+    for b in bodies:
         kind = b.motion.dynamic_axes
         if kind is None:
             continue
-        c, d, ct, dtan = point_coefficients(model, b)
+        a = b.area_vectors[:, 3]
+        c, d, ct, dtan = (law[5 + 2 * j] + law[6 + 2 * j] * a for j in range(4))  # LAW_SLOTS
         # a vertex may press on every plane at once (a box in a corner)
-        planes = max(1, model.slots)
+        planes = max(1, slots)
         k, d = planes * np.maximum(c, ct), planes * np.maximum(d, dtan)
         if kind == "axis":
             K = np.array([[k.sum()]])
@@ -572,10 +593,13 @@ def check_time_step(model):
         Naming ``run.dt`` and the largest stable dt.
     """
     limit, who = stable_time_step(model)
-    if model.scene.run.dt > limit:
+    if model.dt > limit:
+        asked = model.scene.run.dt
+        rounded = ("" if asked == "auto" or np.isclose(asked, model.dt, rtol=1e-12, atol=0.0)
+                   else f" (rounded to {model.dt:.6g} s for whole steps per cycle)")
         raise SceneError(model.scene.source, "run.dt",
-                         f"{model.scene.run.dt:.3g} s is above the stability limit of the contact "
-                         f"on body {who!r}; the largest stable dt is {limit:.3g} s")
+                         f"{asked!r} s{rounded} is above the stability limit of the contact "
+                         f"on body {who!r}; the largest stable dt is {limit:.6g} s")
     return limit
 
 

@@ -14,6 +14,7 @@ Keys of bodies and surfaces are written by index: ``body[0].density``,
 
 import copy
 import dataclasses
+import importlib.util
 import math
 import numbers
 import os
@@ -34,6 +35,8 @@ WEAR_DIRECTIONS = ("contact_normal", "vertex_normal")
 ACCELERATIONS = ("none", "cycle_jump")
 JUMPS = ("implicit", "explicit")
 UNITS = ("m", "mm", "cm", "um", "in")
+#: how a part's frames are written: a .pvd collection of .vtp files, or one VTKHDF file
+SERIES = ("pvd", "vtkhdf")
 #: mesh files that state their own length unit (geometry.STEP_FORMATS)
 STEP_FORMATS = (".step", ".stp")
 MOTIONS = ("free", "guided", "prescribed", "fixed")
@@ -85,27 +88,37 @@ def _check_mesh_or_shape(obj):
 
 @dataclass(frozen=True, kw_only=True)
 class RunConfig:
-    """``[run]``: mode, duration (s), step dt (s), frames, history rows, gravity (m/s²).
+    """``[run]``: mode, duration (s), step dt (s, or "auto": see
+    :func:`meshwear.model.auto_time_step`), frames, history rows, gravity (m/s²),
+    series ("pvd" or "vtkhdf": the frames' file format).
 
     ``frames = 0`` writes no VTK frames, 1 only t = 0; ``history >= 2``.
     """
 
     mode: str = "dynamic"
     duration: float = 1.0
-    dt: float = 1e-5
+    dt: float | str = "auto"
     frames: int = 51
     history: int = 1001
     gravity: tuple = (0.0, 0.0, -9.81)
+    series: str = "pvd"
 
     def __post_init__(self):
         _set(self, "mode", _choice, MODES)
         _set(self, "duration", _positive)
-        _set(self, "dt", _positive)
-        if self.dt > self.duration:
+        if self.dt != "auto":
+            if isinstance(self.dt, str):
+                raise SceneError("", "dt", f'expected a step in seconds or "auto", got {self.dt!r}')
+            _set(self, "dt", _positive)
+        if self.dt != "auto" and self.dt > self.duration:
             raise SceneError("", "dt", f"{self.dt!r} s is longer than duration = {self.duration!r} s")
         _set(self, "frames", _integer, 0)
         _set(self, "history", _integer, 2)
         _set(self, "gravity", _vector)
+        _set(self, "series", _choice, SERIES)
+        if self.series == "vtkhdf" and importlib.util.find_spec("h5py") is None:
+            raise SceneError("", "series", "'vtkhdf' needs h5py, the optional hdf extra: "
+                             "pip install 'meshwear[hdf]'")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -526,7 +539,7 @@ class Scene:
             fail("body", "no bodies; add at least one [[body]] table")
         items = ([(f"body[{i}]", b, BodyConfig) for i, b in enumerate(self.bodies)]
                  + [(f"surface[{j}]", s, SurfaceConfig) for j, s in enumerate(self.surfaces)])
-        # each name owns the output paths <name>.pvd and <name>/; no two may
+        # each name owns the output paths <name>.pvd, <name>.vtkhdf and <name>/; no two may
         # clash, nor with history.csv / summary.json, ignoring case (as
         # Windows and macOS file systems do)
         taken = {"history.csv": "history.csv", "summary.json": "summary.json"}
@@ -537,7 +550,8 @@ class Scene:
             if item.name in names:
                 fail(key + ".name", f"{item.name!r} is already the name of {names[item.name]}")
             names[item.name] = key
-            paths = (item.name.casefold(), item.name.casefold() + ".pvd")
+            paths = (item.name.casefold(), item.name.casefold() + ".pvd",
+                     item.name.casefold() + ".vtkhdf")
             for path in paths:
                 if path in taken:
                     fail(key + ".name", f"{item.name!r}: its output files would clash with "

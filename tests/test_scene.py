@@ -138,7 +138,7 @@ def test_full_scene_parses_to_the_given_values(tmp_path):
 
 def test_minimal_scene_gets_the_documented_defaults(tmp_path):
     scene = load_scene(write(tmp_path, MINIMAL + FLOOR))
-    assert scene.run == RunConfig(mode="dynamic", duration=1.0, dt=1e-5, frames=51, history=1001,
+    assert scene.run == RunConfig(mode="dynamic", duration=1.0, dt="auto", frames=51, history=1001,
                                   gravity=(0.0, 0.0, -9.81))
     c = scene.contact
     assert (c.stiffness, c.stiffness_per_area, c.damping, c.damping_per_area) == (1e6, None, 20.0, None)
@@ -241,6 +241,7 @@ BAD = [
     ("format as a string", "FORMAT:format = '1'\n" + _body(), "format"),
     ("negative dt", "[run]\ndt = -1e-5\n" + _body(), "run.dt"),
     ("dt > duration", "[run]\nduration = 0.1\ndt = 0.2\n" + _body(), "run.dt"),
+    ("dt a word", "[run]\ndt = 'fast'\n" + _body(), "run.dt"),
     ("non-numeric value", "[run]\nduration = 'abc'\n" + _body(), "run.duration"),
     ("bool is not a number", "[contact]\nfriction = true\n" + _body(), "contact.friction"),
     ("float frames", "[run]\nframes = 2.5\n" + _body(), "run.frames"),

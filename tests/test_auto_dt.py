@@ -1,0 +1,125 @@
+"""``run.dt = "auto"``, the default (docs/scene-format.md): a minimal dynamic
+scene runs at its largest stable step, a quasi-static one resolves its cycle
+into 200 steps, cycle jumping rounds the step down to whole steps per cycle
+(never above the stable limit), and an explicit dt above the limit is
+refused with the limit in full."""
+
+import json
+
+import numpy as np
+import pytest
+
+from meshwear.cli import main
+from meshwear.model import (AUTO_STEPS_PER_CYCLE, AUTO_STEPS_PER_RUN, build_model,
+                            check_time_step, stable_time_step)
+from meshwear.scene import SceneError, load_scene
+
+# the issue's minimal scene: a steel block dropped on a floor, nothing but
+# what it needs (stiffness 1e9 N/m per vertex: the default 1e-5 s was unstable)
+MINIMAL = """format = 1
+
+[run]
+duration = {duration}
+
+[contact]
+stiffness = 1e9
+
+[[body]]
+name = "block"
+shape = {{ type = "box", size = [0.01, 0.01, 0.005] }}
+position = [0.0, 0.0, 0.0025]
+
+[[surface]]
+name = "floor"
+"""
+
+# a pin driven round a track, quasi-static
+PIN = """format = 1
+
+[run]
+mode = "{mode}"
+duration = 3.0
+
+[contact]
+stiffness_per_area = 1e12
+damping_per_area = 1e5
+
+[wear]
+law = "archard"
+coefficient = 1e-13
+{wear}
+
+[[body]]
+name = "pin"
+shape = {{ type = "cylinder", radius = 0.003, height = 0.01, sections = 12 }}
+position = [0.0, 0.0, 0.005]
+force = [0.0, 0.0, -10.0]
+motion = "guided"
+
+[body.path]
+circle = {{ radius = 0.01, frequency = 1.7 }}
+free_axis = [0.0, 0.0, 1.0]
+
+[[surface]]
+name = "disc"
+"""
+
+
+def write(tmp_path, text):
+    path = tmp_path / "scene.toml"
+    path.write_text(text)
+    return path
+
+
+def test_a_minimal_dynamic_scene_runs_at_its_stable_step(tmp_path, capsys):
+    path = write(tmp_path, MINIMAL.format(duration=0.002))
+    model = build_model(load_scene(path))
+    limit, who = stable_time_step(model)
+    assert who == "block" and np.isfinite(limit)
+    assert model.dt <= limit and model.dt > 0.999 * limit  # whole steps: a hair below
+    assert model.n_steps * model.dt == pytest.approx(0.002, rel=1e-12)
+    out = tmp_path / "out"
+    assert main(["run", str(path), "-o", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "ok" and summary["dt"] == pytest.approx(model.dt, rel=1e-12)
+    assert "is above the stability limit" not in capsys.readouterr().err
+
+
+def test_a_long_run_is_resolved_into_at_least_the_run_s_share(tmp_path):
+    # a soft contact's stable step is long: the run still gets its 1000 steps
+    text = MINIMAL.format(duration=0.5).replace("stiffness = 1e9", "stiffness = 10.0\ndamping = 0.0")
+    model = build_model(load_scene(write(tmp_path, text)))
+    assert stable_time_step(model)[0] > 0.5 / AUTO_STEPS_PER_RUN
+    assert model.n_steps == AUTO_STEPS_PER_RUN
+
+
+def test_quasi_static_auto_resolves_the_cycle(tmp_path):
+    model = build_model(load_scene(write(tmp_path, PIN.format(mode="quasi-static", wear=""))))
+    assert model.dt * AUTO_STEPS_PER_CYCLE <= 1 / 1.7 * (1 + 1e-12)
+    assert model.n_steps == int(np.ceil(3.0 * 1.7 * AUTO_STEPS_PER_CYCLE - 1e-9))
+
+
+def test_cycle_jumping_rounds_the_step_down_to_whole_steps_per_cycle(tmp_path):
+    jump = 'acceleration = "cycle_jump"'
+    model = build_model(load_scene(write(tmp_path, PIN.format(mode="dynamic", wear=jump))))
+    limit = stable_time_step(model)[0]
+    assert model.cycle_steps * model.dt == pytest.approx(1 / 1.7, rel=1e-12)
+    assert model.dt <= limit
+    assert model.cycle_steps == max(AUTO_STEPS_PER_CYCLE, int(np.ceil(1 / 1.7 / limit)))
+    # an explicit dt a hair below the limit is not rounded above it either
+    path = write(tmp_path, PIN.format(mode="dynamic", wear=jump).replace(
+        "duration = 3.0", f"duration = 3.0\ndt = {float(0.9999 * limit)!r}"))
+    model = build_model(load_scene(path))
+    assert model.dt <= limit
+    check_time_step(model)
+
+
+def test_an_explicit_step_above_the_limit_is_refused_with_the_limit(tmp_path):
+    limit = stable_time_step(build_model(load_scene(write(tmp_path, MINIMAL.format(
+        duration=0.01)))))[0]
+    path = write(tmp_path, MINIMAL.format(duration=0.01).replace(
+        "[run]", f"[run]\ndt = {float(1.02 * limit)!r}"))
+    with pytest.raises(SceneError, match=r"run\.dt.*largest stable dt is") as err:
+        check_time_step(build_model(load_scene(path)))
+    shown = float(str(err.value).rsplit(" is ", 1)[1].split()[0])
+    assert shown == pytest.approx(limit, rel=1e-5)  # not rounded to the refused value
