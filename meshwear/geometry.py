@@ -6,6 +6,7 @@ function returns plain arrays, ``vertices : (n, 3) float64`` (C-contiguous) and
 ``faces : (m, 3) int64`` with counter-clockwise (outward) winding.
 """
 
+import importlib
 import logging
 from pathlib import Path
 
@@ -124,7 +125,7 @@ def _read_trimesh(path):
 def _read_step(path):
     """Triangles of a STEP file's solids, tessellated by OpenCASCADE, in metres."""
     try:
-        import cascadio  # noqa: F401  (trimesh's STEP loader needs it)
+        importlib.import_module("cascadio")  # trimesh's STEP loader needs it
     except ImportError:
         raise MeshError(f"{path}: reading STEP files needs the optional cad extra: "
                         f"{CAD_EXTRA}") from None
