@@ -207,10 +207,11 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=
     if not quiet:
         print(f"done in {elapsed:.1f} s: {model.n_steps} steps, "
               f"{len(model.frame_steps)} frames")
+        suffix = "." + scene.run.series
         for body in model.bodies:
-            print(f"  ParaView series: {out_dir / (body.name + '.pvd')}")
+            print(f"  ParaView series: {out_dir / (body.name + suffix)}")
         for surface in model.surfaces.slots:
-            print(f"  surface: {out_dir / (surface.name + '.pvd')}")
+            print(f"  surface: {out_dir / (surface.name + suffix)}")
         print(f"  history: {out_dir / 'history.csv'}, summary: {out_dir / 'summary.json'}")
     return EXIT_OK
 

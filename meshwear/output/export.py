@@ -21,17 +21,55 @@ class ExportError(ValueError):
     """A part, frame or folder that cannot be exported (one line)."""
 
 
+#: suffixes of a part's series: a .pvd collection of .vtp frames, or one VTKHDF file
+SERIES_SUFFIXES = (".pvd", ".vtkhdf")
+
+
+def series_path(out_dir, name):
+    """The series file of ``name`` in ``out_dir`` (``.pvd`` or ``.vtkhdf``;
+    the ``.pvd`` path when there is none)."""
+    for suffix in SERIES_SUFFIXES[::-1]:
+        path = Path(out_dir) / f"{name}{suffix}"
+        if path.is_file():
+            return path
+    return Path(out_dir) / f"{name}.pvd"
+
+
 def series_frames(out_dir, name):
-    """``[(time, path), ...]`` of the frames of series ``name`` in ``out_dir``."""
-    pvd = Path(out_dir) / f"{name}.pvd"
+    """``[(time, frame), ...]`` of the frames of series ``name`` in
+    ``out_dir``; :func:`read_frame` reads a ``frame``."""
+    path = series_path(out_dir, name)
+    if path.suffix == ".vtkhdf":
+        from .vtkhdf import read_frames
+
+        try:
+            return read_frames(path)
+        except (OSError, KeyError, IndexError) as err:
+            raise ExportError(f"{path}: not a readable VTKHDF series ({err})") from None
     try:
-        root = ET.parse(pvd).getroot()
+        root = ET.parse(path).getroot()
     except FileNotFoundError:
-        raise ExportError(f"{pvd}: no such series") from None
+        raise ExportError(f"{path}: no such series") from None
     except ET.ParseError as err:
-        raise ExportError(f"{pvd}: not a readable .pvd ({err})") from None
+        raise ExportError(f"{path}: not a readable .pvd ({err})") from None
     return [(float(d.get("timestep")), Path(out_dir) / d.get("file"))
             for d in root.iter("DataSet")]
+
+
+def read_frame(frame):
+    """A frame of :func:`series_frames` as a ``pyvista.PolyData`` with its
+    point and field data."""
+    if callable(frame):
+        try:
+            return frame()
+        except (OSError, KeyError, IndexError, ValueError) as err:
+            raise ExportError(f"cannot read the frame ({err})") from None
+    import pyvista
+
+    try:
+        return pyvista.read(frame)
+    except (FileNotFoundError, OSError, ValueError) as err:
+        raise ExportError(f"{frame}: cannot read the frame ({err})") from None
 
 
 def worn_parts(out_dir):
@@ -39,10 +77,11 @@ def worn_parts(out_dir):
     the series whose frames carry a pose."""
     out_dir = Path(out_dir)
     names = []
-    for pvd in sorted(out_dir.glob("*.pvd")):
-        frames = series_frames(out_dir, pvd.stem)
-        if frames and _pose(_read(frames[0][1])) is not None:
-            names.append(pvd.stem)
+    stems = sorted({p.stem for suffix in SERIES_SUFFIXES for p in out_dir.glob(f"*{suffix}")})
+    for stem in stems:
+        frames = series_frames(out_dir, stem)
+        if frames and _pose(read_frame(frames[0][1])) is not None:
+            names.append(stem)
     return names
 
 
@@ -72,15 +111,15 @@ def part_mesh(out_dir, name, frame=-1):
     """
     frames = series_frames(out_dir, name)
     if not frames:
-        raise ExportError(f"{Path(out_dir) / (name + '.pvd')}: the series has no frames")
+        raise ExportError(f"{series_path(out_dir, name)}: the series has no frames")
     if not -len(frames) <= frame < len(frames):
         raise ExportError(f"--frame {frame}: {name!r} has {len(frames)} frames "
                           f"(0 to {len(frames) - 1}, or -1 for the last)")
-    time, path = frames[frame]
-    mesh = _read(path)
+    time, source = frames[frame]
+    mesh = read_frame(source)
     pose = _pose(mesh)
     if pose is None:
-        raise ExportError(f"{path}: {name!r} is not a worn part (its frames carry no pose); "
+        raise ExportError(f"{series_path(out_dir, name)}: {name!r} is not a worn part (its frames carry no pose); "
                           "export takes bodies and surfaces with wear = true")
     origin, q = pose
     R = _rotation(q)
@@ -117,15 +156,6 @@ def export(out_dir, names=None, frame=-1, fmt="stl", units="m", dest=None):
         mesh.export(path)
         written.append(path)
     return written
-
-
-def _read(path):
-    import pyvista
-
-    try:
-        return pyvista.read(path)
-    except (FileNotFoundError, OSError, ValueError) as err:
-        raise ExportError(f"{path}: cannot read the frame ({err})") from None
 
 
 def _pose(mesh):

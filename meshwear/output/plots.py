@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .export import ExportError, chosen_parts, part_mesh, series_frames
+from .export import (SERIES_SUFFIXES, ExportError, chosen_parts, part_mesh, read_frame,
+                     series_frames)
 
 #: pixels of the wear maps
 MAP_SIZE = (900, 700)
@@ -49,7 +50,8 @@ def plot(out_dir, names=None, dest=None, profile=None):
     out_dir = Path(out_dir)
     if not out_dir.is_dir():
         raise ExportError(f"{out_dir}: no such output folder")
-    if (out_dir / "sweep.csv").is_file() and not list(out_dir.glob("*.pvd")):
+    if (out_dir / "sweep.csv").is_file() and not any(
+            next(out_dir.glob(f"*{suffix}"), None) for suffix in SERIES_SUFFIXES):
         if names or profile is not None:
             raise ExportError(f"{out_dir}: a sweep's folder: --part and --profile apply to a "
                               "run's folder (one of its run_NNN)")
@@ -76,11 +78,9 @@ def plot(out_dir, names=None, dest=None, profile=None):
 
 
 def _mesh_fields(out_dir, name, frame=-1):
-    import pyvista
-
     vertices, faces, time = part_mesh(out_dir, name, frame)
-    path = series_frames(out_dir, name)[frame][1]
-    depth = np.asarray(pyvista.read(path).point_data["wear_depth"], float)
+    depth = np.asarray(read_frame(series_frames(out_dir, name)[frame][1])
+                       .point_data["wear_depth"], float)
     return vertices, faces, depth, time
 
 

@@ -11,6 +11,16 @@ from .fields import body_quantities, body_totals, part_quantities
 from .tables import HISTORY_COLUMNS, HistoryWriter, write_json_atomic
 from .vtk import PVDSeries
 
+
+def series_class(model):
+    """The writer of ``run.series``: :class:`PVDSeries` or
+    :class:`meshwear.output.vtkhdf.VTKHDFSeries`."""
+    if model.scene.run.series == "vtkhdf":
+        from .vtkhdf import VTKHDFSeries
+
+        return VTKHDFSeries
+    return PVDSeries
+
 #: columns added to the history.csv of docs/outputs.md (extend, never rename)
 EXTRA_COLUMNS = ("wx", "wy", "wz", "tx", "ty", "tz", "contact_points", "stick_points", "slip_points",
                  "resolved")
@@ -18,7 +28,7 @@ FIELDS = ("wear_depth", "normal_force", "friction_force", "pressure", "contact_s
 
 
 class RunRecorder:
-    """Writes ``OUT/<body>.pvd`` series, ``history.csv`` and ``summary.json``.
+    """Writes ``OUT/<body>.pvd`` series (or ``.vtkhdf``), ``history.csv`` and ``summary.json``.
 
     Parameters
     ----------
@@ -32,25 +42,26 @@ class RunRecorder:
     def __init__(self, out_dir, model, resume_until=None):
         self.out_dir = Path(out_dir)
         self.out_dir.mkdir(parents=True, exist_ok=True)
-        self.series = {b.name: PVDSeries(self.out_dir, b.name, b.faces, resume_until)
+        Series = series_class(model)
+        self.series = {b.name: Series(self.out_dir, b.name, b.faces, resume_until)
                        for b in model.bodies}
         self.history = HistoryWriter(self.out_dir / "history.csv", EXTRA_COLUMNS, resume_until)
         # counter-surfaces: one frame if they stay put, else one per frame
         self.moving = {}
         # worn counter-surfaces: a series with a body's fields, history rows
-        self.parts = {m: PVDSeries(self.out_dir, surface.name, surface.faces, resume_until)
+        self.parts = {m: Series(self.out_dir, surface.name, surface.faces, resume_until)
                       for m, surface in enumerate(model.surfaces.per_vertex) if surface.worn}
         for surface in model.surfaces.slots:
             if surface.worn:
                 continue
             vertices, faces = surface.drawing(model.extent)
             if surface.static:
-                still = PVDSeries(self.out_dir, surface.name, faces)
+                still = Series(self.out_dir, surface.name, faces)
                 still.write_frame(0.0, surface.world_vertices(vertices, 0.0), {})
                 still.close()
             else:
                 self.moving[surface.name] = (surface, vertices,
-                                             PVDSeries(self.out_dir, surface.name, faces,
+                                             Series(self.out_dir, surface.name, faces,
                                                        resume_until))
 
     def on_sample(self, model, state):

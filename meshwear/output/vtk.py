@@ -44,11 +44,9 @@ class PVDSeries:
         self.frame_dir.mkdir(parents=True, exist_ok=True)
         # resuming keeps the frames up to ``resume_until`` (s) of the stopped run
         self._entries = self._read_entries(resume_until) if resume_until is not None else []
-        kept = {Path(f).name for _, f in self._entries}
-        stale = re.compile(re.escape(name) + r"_\d{5,}\.vtp")
-        for old in self.frame_dir.iterdir():
-            if stale.fullmatch(old.name) and old.name not in kept:
-                old.unlink()
+        remove_frames(self.out_dir, name, keep={Path(f).name for _, f in self._entries})
+        # an older run's series of this name in the other format
+        (self.out_dir / f"{name}.vtkhdf").unlink(missing_ok=True)
         self._closed = False
         self._write_pvd()           # an empty collection replaces any older series
 
@@ -134,6 +132,18 @@ class PVDSeries:
 
     def __exit__(self, *exc):
         self.close()
+
+
+def remove_frames(out_dir, name, keep=()):
+    """Delete the numbered ``.vtp`` frames of series ``name`` in ``out_dir``
+    (those not in ``keep``, a set of file names)."""
+    folder = Path(out_dir) / name
+    if not folder.is_dir():
+        return
+    stale = re.compile(re.escape(name) + r"_\d{5,}\.vtp")
+    for old in folder.iterdir():
+        if stale.fullmatch(old.name) and old.name not in keep:
+            old.unlink()
 
 
 def plane_patch(point, normal, size, divisions=1):
