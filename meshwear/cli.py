@@ -219,9 +219,6 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=
 def _check(scene_path, overrides=()):
     import numpy as np
 
-    from . import stepper
-    from .model import initial_state
-
     scene, model, limit = _prepare(scene_path, overrides)
     print(f"scene {scene.source}: ok (format 1, mode {scene.run.mode})")
     for key, value in overrides:
@@ -242,20 +239,17 @@ def _check(scene_path, overrides=()):
         print(f"  cycle jumping: {model.cycle_steps} steps per cycle, {cycles:.6g} cycles, "
               f"{scene.wear.jump} jumps, tolerance {scene.wear.tolerance:g}; outputs inside "
               "jumps are filled from them")
-    state = initial_state(model)
-    warm = 1 if model.n_steps > 1 else 0
-    stepper.advance(model, state, warm)  # compile (or load the cached) kernels
-    trial = min(model.n_steps - warm, 200)
-    start = time.perf_counter()
-    stepper.advance(model, state, warm + trial)
-    per_step = max(time.perf_counter() - start, 1e-9) / max(trial, 1)
-    active = sum(len(s.active) for s in state.bodies)
-    total = sum(len(b.tributary_area) for b in model.bodies)
-    points = active * max(1, model.slots)
-    full = "if every cycle were resolved " if model.cycle_steps else ""
-    print(f"  estimated run time {full}{per_step * model.n_steps:.3g} s "
-          f"({per_step * 1e6:.3g} µs per step, {points / per_step:.3g} vertex-steps/s; "
-          f"{active} of {total} vertices within reach of a surface)")
+    from .estimate import estimate_run
+
+    e = estimate_run(model)
+    full = "" if not model.cycle_steps else (
+        "with cycle jumping " if e.trial_covered >= model.n_steps else
+        f"with cycle jumps growing as in a {e.trial_time:.2g} s trial ")
+    print(f"  estimated run time {full}{e.total:.3g} s: stepping {e.stepping:.3g} s "
+          f"({e.per_step * 1e6:.3g} µs per step, {e.points / e.per_step:.3g} vertex-steps/s; "
+          f"{e.active} of {e.vertices} vertices within reach of a surface), "
+          f"writing {e.writing:.3g} s ({len(model.frame_steps)} frames, "
+          f"{len(model.sample_steps)} history rows)")
     return EXIT_OK
 
 

@@ -123,3 +123,21 @@ def test_an_explicit_step_above_the_limit_is_refused_with_the_limit(tmp_path):
         check_time_step(build_model(load_scene(path)))
     shown = float(str(err.value).rsplit(" is ", 1)[1].split()[0])
     assert shown == pytest.approx(limit, rel=1e-5)  # not rounded to the refused value
+
+
+def test_check_s_estimate_counts_the_outputs_and_caps_jumps_at_resolved(tmp_path):
+    from meshwear.estimate import estimate_run
+
+    few = build_model(load_scene(write(tmp_path, PIN.format(mode="quasi-static", wear="")),
+                                 [("run.frames", 2), ("run.history", 2)]))
+    many = build_model(load_scene(write(tmp_path, PIN.format(mode="quasi-static", wear="")),
+                                  [("run.frames", 400), ("run.history", 400)]))
+    a, b = estimate_run(few), estimate_run(many)
+    assert a.total == a.stepping + a.writing and a.writing > 0
+    assert b.writing > 2 * a.writing  # 200 times the outputs cost more
+    jumped = build_model(load_scene(write(tmp_path, PIN.format(
+        mode="quasi-static", wear='acceleration = "cycle_jump"').replace(
+        "duration = 3.0", "duration = 300.0"))))
+    e = estimate_run(jumped)
+    assert 0 < e.stepping <= e.per_step * jumped.n_steps
+    assert e.trial_covered > 0
