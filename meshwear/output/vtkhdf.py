@@ -6,9 +6,9 @@ it as a time series). The triangles are written once and shared by every
 step (each step's cell offsets point at them); each frame appends its
 points, point data and field data. After every frame the step count is
 updated last and the file flushed, so a run stopped between frames leaves
-a file ParaView opens, with every frame written so far. The file is not
-locked while the run writes it, so it can be opened before the run ends
-(HDF5's file locks would make ParaView and the run wait for each other).
+a file ParaView opens, with every frame written so far. HDF5 does not let
+a file be read while it is written: the run holds HDF5's file lock, and
+the file is opened after the run ends or stops (use .pvd to watch a run).
 
 Needs h5py (the ``hdf`` extra).
 """
@@ -63,7 +63,7 @@ class VTKHDFSeries:
         self.path = self.out_dir / f"{name}{self.suffix}"
         self._closed = False
         if resume_until is not None and self.path.is_file():
-            self._file = h5py.File(self.path, "r+", locking=False)
+            self._file = h5py.File(self.path, "r+")
             self._truncate(resume_until)
         else:
             # an older run's .pvd series of this name
@@ -71,7 +71,7 @@ class VTKHDFSeries:
 
             (self.out_dir / f"{name}.pvd").unlink(missing_ok=True)
             remove_frames(self.out_dir, name)
-            self._file = h5py.File(self.path, "w", locking=False)
+            self._file = h5py.File(self.path, "w")
             self._create()
 
     # ---------------------------------------------------------------- layout
@@ -241,7 +241,7 @@ def read_frames(path):
     """``[(time, load), ...]`` of a ``.vtkhdf`` series; ``load()`` gives the
     frame as a ``pyvista.PolyData`` with its point and field data."""
     h5py = _h5py()
-    with h5py.File(path, "r", locking=False) as f:
+    with h5py.File(path, "r") as f:
         steps = f["VTKHDF/Steps"]
         times = [float(t) for t in steps["Values"][:int(steps.attrs["NSteps"])]]
     return [(t, (lambda k=k: read_frame(path, k))) for k, t in enumerate(times)]
@@ -252,7 +252,7 @@ def read_frame(path, step):
     import pyvista
 
     h5py = _h5py()
-    with h5py.File(path, "r", locking=False) as f:
+    with h5py.File(path, "r") as f:
         root, steps = f["VTKHDF"], f["VTKHDF/Steps"]
         start, n = int(steps["PointOffsets"][step]), int(root["NumberOfPoints"][step])
         polygons = root["Polygons"]
