@@ -11,7 +11,6 @@ import time
 from dataclasses import dataclass
 
 from . import stepper
-from .output import filled
 from .model import initial_state
 
 #: steps timed for the per-step cost
@@ -82,11 +81,7 @@ def _writing(model, state):
         start = time.perf_counter()
         recorder.on_sample(model, state)
         sample = time.perf_counter() - start
-        recorder.history.close()
-        for series in list(recorder.series.values()) + list(recorder.parts.values()):
-            series.close()
-        for _, _, series in recorder.moving.values():
-            series.close()
+        recorder.finish()
     return setup + frame * len(model.frame_steps) + sample * len(model.sample_steps)
 
 
@@ -103,48 +98,28 @@ def _jumping(model, resolved):
     state = initial_state(model)
     start = time.perf_counter()
     budget = min(JUMP_TRIAL, resolved)
-    last = {"which": None, "limits": {}}   # the bound that set the latest jump
 
     def progress(step, n_steps):
-        js = state.jump
-        if js is not None:
-            changed = [k for k, v in js.limits.items() if v != last["limits"].get(k, 0)]
-            if changed:
-                last["which"] = changed[0]
-            last["limits"] = dict(js.limits)
         if time.perf_counter() - start > budget:
             raise _Budget
 
-    # outputs inside a jump are filled from it (output.filled.write): their
-    # cost, beyond writing them, is timed per output and counted apart
-    filling = {"seconds": 0.0, "outputs": 0}
-    write = filled.write
-
-    def timed_write(model, state, stop, jump, *args, **kwargs):
-        before, outputs = time.perf_counter(), model.output_steps
-        write(model, state, stop, jump, *args, **kwargs)
-        filling["seconds"] += time.perf_counter() - before
-        end = stop + jump * model.cycle_steps
-        filling["outputs"] += int(((outputs > stop) & (outputs < end)).sum())
-
-    filled.write = timed_write
     try:
         run_cycle_jump(model, state, progress=progress)
     except _Budget:
         pass
-    finally:
-        filled.write = write
     elapsed = time.perf_counter() - start
     if state.step >= model.n_steps:
         return elapsed, elapsed, state.step
     n_c = model.cycle_steps
     js = state.jump
-    per_output = filling["seconds"] / max(filling["outputs"], 1)
+    # outputs inside a jump are filled from it: their cost beyond writing
+    # them goes with the outputs left, not with the cycles
+    per_output = js.fill_seconds / max(js.filled_outputs, 1)
     remaining = int((model.output_steps > state.step).sum())
     # a resolved cycle, its jump's work included
-    per_cycle = (elapsed - filling["seconds"]) / max(js.resolved_steps / n_c, 1.0)
+    per_cycle = (elapsed - js.fill_seconds) / max(js.resolved_steps / n_c, 1.0)
     settle = 0 if model.quasi_static else 1      # a dynamic run resolves a cycle after a jump
-    growing = last["which"] in (None, "growth")
+    growing = js.last_limit in (None, "growth")
     position, total = state.step / n_c, model.n_steps / n_c
     jump, seconds = float(js.last_jump), elapsed + per_output * remaining
     while position < total and seconds < resolved:

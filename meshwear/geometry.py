@@ -117,7 +117,11 @@ def _not_a_file(path):
 def _read_trimesh(path):
     import trimesh
 
-    mesh = trimesh.load(str(path), force="mesh", process=False)
+    return _trimesh_arrays(trimesh.load(str(path), force="mesh", process=False))
+
+
+def _trimesh_arrays(mesh):
+    """(vertices, faces) of what trimesh loaded (empty when it is no mesh)."""
     return (np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64),
             np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64))
 
@@ -131,11 +135,9 @@ def _read_step(path):
                         f"{CAD_EXTRA}") from None
     import trimesh
 
-    mesh = trimesh.load(str(path), file_type="step", force="mesh", process=False,
-                        tol_linear=STEP_LINEAR_TOLERANCE, tol_relative=True,
-                        tol_angular=STEP_ANGULAR_TOLERANCE)
-    return (np.asarray(getattr(mesh, "vertices", np.zeros((0, 3))), dtype=np.float64),
-            np.asarray(getattr(mesh, "faces", np.zeros((0, 3))), dtype=np.int64))
+    return _trimesh_arrays(trimesh.load(str(path), file_type="step", force="mesh",
+                                        process=False, tol_linear=STEP_LINEAR_TOLERANCE,
+                                        tol_relative=True, tol_angular=STEP_ANGULAR_TOLERANCE))
 
 
 def _read_meshio(path):

@@ -23,6 +23,7 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from .geometry import STEP_FORMATS
 from .kernels.laws import LAWS
 from .scene_checks import (SceneError, _boolean, _choice, _coefficient, _did_you_mean,
                            _direction, _exclusive, _instance, _integer, _name, _nonnegative,
@@ -37,8 +38,6 @@ JUMPS = ("implicit", "explicit")
 UNITS = ("m", "mm", "cm", "um", "in")
 #: how a part's frames are written: a .pvd collection of .vtp files, or one VTKHDF file
 SERIES = ("pvd", "vtkhdf")
-#: mesh files that state their own length unit (geometry.STEP_FORMATS)
-STEP_FORMATS = (".step", ".stp")
 MOTIONS = ("free", "guided", "prescribed", "fixed")
 SURFACE_TYPES = ("plane", "mesh", "cylinder", "sphere")
 SIDES = ("outside", "inside")

@@ -37,6 +37,7 @@ dynamic mode the cycle after a jump only lets the contact settle and the
 next one is measured.
 """
 
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -75,6 +76,11 @@ class JumpState:
                                                     # cycle, last measured (or None)
     part_error: list = field(default_factory=list)  # per worn counter-part (V,) estimated
                                                      # error of its depth (m)
+    # not saved with checkpoints: what the run has done since it (re)started,
+    # for meshwear check's estimate
+    last_limit: str | None = None                   # the bound that set the latest jump
+    fill_seconds: float = 0.0                       # wall time filling outputs from jumps
+    filled_outputs: int = 0                         # outputs filled from jumps
 
 
 def penetration(model, body, s):
@@ -215,9 +221,13 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
             for error, (_, _, estimate) in zip(js.error, results):
                 error += estimate
             js.limits[which] = js.limits.get(which, 0) + 1
+            js.last_limit = which
             spans = _jump(model, state, before, rates, jump, results, measures)
             part_spans = _jump_parts(model, parts, before_parts, part_rates, js, jump)
-            filled.write(model, state, stop, jump, snapshots, spans, observers, part_spans)
+            before_fill = time.perf_counter()
+            js.filled_outputs += filled.write(model, state, stop, jump, snapshots, spans,
+                                              observers, part_spans)
+            js.fill_seconds += time.perf_counter() - before_fill
             js.jumps += 1
             js.settling = not model.quasi_static
         js.last_jump = jump

@@ -8,6 +8,7 @@ import json
 import signal
 import time
 
+import h5py
 import numpy as np
 import pytest
 import vtk
@@ -81,17 +82,19 @@ def test_resuming_keeps_the_frames_up_to_the_checkpoint(tmp_path):
         assert series.times == []
 
 
-def test_a_frame_cut_short_is_dropped_by_the_next(tmp_path):
+def test_a_frame_cut_short_is_dropped_on_resume(tmp_path):
     series = VTKHDFSeries(tmp_path, "pin", FACES)
     series.write_frame(0.0, *frames(0))
     # a run killed while appending frame 1: its points are in, its step is not counted
     series._append(series._file["VTKHDF/Points"], frames(1)[0])
-    series._file.flush()
-    assert [t for t, _ in read_frames(tmp_path / "pin.vtkhdf")] == [0.0]
-    series.write_frame(0.5, *frames(2))
     series.close()
+    assert [t for t, _ in read_frames(tmp_path / "pin.vtkhdf")] == [0.0]
+    with VTKHDFSeries(tmp_path, "pin", FACES, resume_until=0.0) as series:  # --resume
+        series.write_frame(0.5, *frames(2))
     out = vtk_read(tmp_path / "pin.vtkhdf", 0.5)
     np.testing.assert_array_equal(vtk_to_numpy(out.GetPoints().GetData()), frames(2)[0])
+    with h5py.File(tmp_path / "pin.vtkhdf", "r") as f:   # the cut rows are gone
+        assert f["VTKHDF/Points"].shape == (2 * len(frames(0)[0]), 3)
 
 
 def test_a_run_writes_the_frames_of_its_pvd_twin(tmp_path, capsys):

@@ -79,14 +79,15 @@ def write(model, state, stop, jump, snapshots, spans, observers, part_spans=()):
     (``stop`` to ``stop + jump`` cycles), filled from it (``spans``: per body,
     the jumped arrays at its start and end, and the shift of its position;
     ``part_spans`` the same per worn counter-part, in the order of
-    ``state.parts``)."""
+    ``state.parts``). Returns the number of outputs written."""
     from ..simulate import check
 
     n_c = model.cycle_steps
     end = stop + jump * n_c
     schedule = model.output_steps
     start = stop - n_c
-    for o in schedule[(schedule > stop) & (schedule < end)].tolist():
+    inside = schedule[(schedule > stop) & (schedule < end)].tolist()
+    for o in inside:
         phase = (o - start) % n_c
         shots = snapshots[phase if phase else n_c]
         fraction = (o - stop) / (end - stop)
@@ -107,6 +108,7 @@ def write(model, state, stop, jump, snapshots, spans, observers, part_spans=()):
             if frame:
                 observer.on_frame(model, view)
         state.written = o
+    return len(inside)
 
 
 def _interpolated(part, span, fraction):

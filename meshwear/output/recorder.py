@@ -83,12 +83,17 @@ class RunRecorder:
                                {"resolved": int(state.resolved), "origin": q["origin"],
                                 "orientation": q["orientation"]})
 
-    def close(self, summary):
+    def finish(self):
+        """Close the history and every series."""
         self.history.close()
         for series in list(self.series.values()) + list(self.parts.values()):
             series.close()
         for _, _, series in self.moving.values():
             series.close()
+
+    def close(self, summary):
+        """:meth:`finish`, and write ``summary.json``."""
+        self.finish()
         write_json_atomic(self.out_dir / "summary.json", summary)
 
 

@@ -14,6 +14,45 @@ import numpy as np
 from .tables import write_text_atomic
 
 
+def series_name_and_faces(name, faces):
+    """A series' name (no path separators) and its (m, 3) int64 triangles,
+    checked; shared by :class:`PVDSeries` and the VTKHDF series."""
+    name = str(name)
+    if not name or name in (".", "..") or re.search(r"[/\\\x00]", name):
+        raise ValueError(f"series name {name!r}: must be non-empty and contain no path separators")
+    faces = np.ascontiguousarray(faces, dtype=np.int64)
+    if faces.ndim != 2 or faces.shape[1] != 3:
+        raise ValueError(f"faces have shape {faces.shape}, expected (m, 3)")
+    return name, faces
+
+
+def frame_arrays(points, faces, point_data):
+    """A frame's ``(points, point_data)`` checked against ``faces``: (n, 3)
+    float64 points and C-contiguous (n,) or (n, k) arrays, bool as uint8."""
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise ValueError(f"points have shape {points.shape}, expected (n, 3)")
+    n = len(points)
+    if len(faces) and faces.max() >= n:
+        raise ValueError(f"{n} points, but the faces refer to point {faces.max()}")
+    data = {}
+    for key, value in point_data.items():
+        value = np.asarray(value)
+        if value.dtype == bool:
+            value = value.astype(np.uint8)
+        if value.shape[0] != n or value.ndim > 2:
+            raise ValueError(f"point data {key!r} has shape {value.shape}, expected ({n},) "
+                             f"or ({n}, k)")
+        data[key] = np.ascontiguousarray(value)
+    return points, data
+
+
+def resume_limit(until):
+    """The last frame time a series resumed at ``until`` (s) keeps: ``until``
+    up to rounding."""
+    return until + 1e-12 * max(1.0, abs(until))
+
+
 class PVDSeries:
     """One body's (or surface's) series: ``OUT/<name>.pvd`` + ``OUT/<name>/<name>_NNNNN.vtp``.
 
@@ -30,12 +69,7 @@ class PVDSeries:
     """
 
     def __init__(self, out_dir, name, faces, resume_until=None):
-        name = str(name)
-        if not name or name in (".", "..") or re.search(r"[/\\\x00]", name):
-            raise ValueError(f"series name {name!r}: must be non-empty and contain no path separators")
-        faces = np.ascontiguousarray(faces, dtype=np.int64)
-        if faces.ndim != 2 or faces.shape[1] != 3:
-            raise ValueError(f"faces have shape {faces.shape}, expected (m, 3)")
+        name, faces = series_name_and_faces(name, faces)
         self.out_dir = Path(out_dir)
         self.name = name
         self.faces = faces
@@ -74,20 +108,10 @@ class PVDSeries:
             raise RuntimeError(f"series {self.name!r} is closed")
         import pyvista
 
-        points = np.ascontiguousarray(points, dtype=np.float64)
-        if points.ndim != 2 or points.shape[1] != 3:
-            raise ValueError(f"points have shape {points.shape}, expected (n, 3)")
-        if len(self.faces) and self.faces.max() >= len(points):
-            raise ValueError(f"{len(points)} points, but the faces refer to point {self.faces.max()}")
+        points, data = frame_arrays(points, self.faces, point_data)
         mesh = pyvista.PolyData.from_regular_faces(points, self.faces)
-        for key, value in point_data.items():
-            value = np.asarray(value)
-            if value.dtype == bool:
-                value = value.astype(np.uint8)
-            if value.shape[0] != len(points) or value.ndim > 2:
-                raise ValueError(f"point data {key!r} has shape {value.shape}, expected ({len(points)},) "
-                                 f"or ({len(points)}, k)")
-            mesh.point_data[key] = np.ascontiguousarray(value)
+        for key, value in data.items():
+            mesh.point_data[key] = value
         mesh.field_data["TimeValue"] = np.array([float(time)])   # read by ParaView for a lone frame
         for key, value in (field_data or {}).items():
             mesh.field_data[key] = np.atleast_1d(np.asarray(value))
@@ -104,7 +128,7 @@ class PVDSeries:
 
         if not self.pvd_path.is_file():
             return []
-        limit = until + 1e-12 * max(1.0, abs(until))
+        limit = resume_limit(until)
         entries = [(float(d.get("timestep")), d.get("file"))
                    for d in ET.parse(self.pvd_path).getroot().iter("DataSet")]
         return [(t, f) for t, f in entries if t <= limit and (self.out_dir / f).is_file()]

@@ -5,18 +5,20 @@ VTKHDF format (version 2.2, type PolyData, temporal; ParaView >= 5.13 opens
 it as a time series). The triangles are written once and shared by every
 step (each step's cell offsets point at them); each frame appends its
 points, point data and field data. After every frame the step count is
-updated last and the file flushed, so a run stopped between frames leaves
-a file ParaView opens, with every frame written so far. HDF5 does not let
+updated last and the file flushed, so a run stopped at any moment leaves
+a file ParaView opens, with every frame written so far (``--resume`` drops
+the rows of a frame cut short). HDF5 does not let
 a file be read while it is written: the run holds HDF5's file lock, and
 the file is opened after the run ends or stops (use .pvd to watch a run).
 
 Needs h5py (the ``hdf`` extra).
 """
 
-import re
 from pathlib import Path
 
 import numpy as np
+
+from .vtk import frame_arrays, remove_frames, resume_limit, series_name_and_faces
 
 #: how to install the writer, named by the error when h5py is missing
 HDF_EXTRA = "pip install 'meshwear[hdf]'"
@@ -50,12 +52,7 @@ class VTKHDFSeries:
 
     def __init__(self, out_dir, name, faces, resume_until=None):
         h5py = _h5py()
-        name = str(name)
-        if not name or name in (".", "..") or re.search(r"[/\\\x00]", name):
-            raise ValueError(f"series name {name!r}: must be non-empty and contain no path separators")
-        faces = np.ascontiguousarray(faces, dtype=np.int64)
-        if faces.ndim != 2 or faces.shape[1] != 3:
-            raise ValueError(f"faces have shape {faces.shape}, expected (m, 3)")
+        name, faces = series_name_and_faces(name, faces)
         self.out_dir = Path(out_dir)
         self.out_dir.mkdir(parents=True, exist_ok=True)
         self.name = name
@@ -67,8 +64,6 @@ class VTKHDFSeries:
             self._truncate(resume_until)
         else:
             # an older run's .pvd series of this name
-            from .vtk import remove_frames
-
             (self.out_dir / f"{name}.pvd").unlink(missing_ok=True)
             remove_frames(self.out_dir, name)
             self._file = h5py.File(self.path, "w")
@@ -112,11 +107,9 @@ class VTKHDFSeries:
     def _growing(group, key, shape, dtype=np.int64, rows=None):
         """An empty dataset that grows by rows; ``rows`` (a frame's point
         count) makes it one compressed chunk per frame."""
-        if rows is None:
-            return group.create_dataset(key, shape=(0,) + shape, maxshape=(None,) + shape,
-                                        dtype=dtype, chunks=True)
+        chunking = {"chunks": True} if rows is None else {"chunks": (rows,) + shape, **COMPRESSION}
         return group.create_dataset(key, shape=(0,) + shape, maxshape=(None,) + shape,
-                                    dtype=dtype, chunks=(rows,) + shape, **COMPRESSION)
+                                    dtype=dtype, **chunking)
 
     @staticmethod
     def _append(dataset, rows):
@@ -133,26 +126,12 @@ class VTKHDFSeries:
         return the file's path."""
         if self._closed:
             raise RuntimeError(f"series {self.name!r} is closed")
-        points = np.ascontiguousarray(points, dtype=np.float64)
-        if points.ndim != 2 or points.shape[1] != 3:
-            raise ValueError(f"points have shape {points.shape}, expected (n, 3)")
+        points, data = frame_arrays(points, self.faces, point_data)
         n = len(points)
-        if len(self.faces) and self.faces.max() >= n:
-            raise ValueError(f"{n} points, but the faces refer to point {self.faces.max()}")
         root, steps = self._file["VTKHDF"], self._file["VTKHDF/Steps"]
         step = int(steps.attrs["NSteps"])
         fields = {"TimeValue": np.array([float(time)])}
         fields.update({k: np.atleast_1d(np.asarray(v)) for k, v in (field_data or {}).items()})
-        data = {}
-        for key, value in point_data.items():
-            value = np.asarray(value)
-            if value.dtype == bool:
-                value = value.astype(np.uint8)
-            if value.shape[0] != n or value.ndim > 2:
-                raise ValueError(f"point data {key!r} has shape {value.shape}, expected ({n},) "
-                                 f"or ({n}, k)")
-            data[key] = value
-        self._cut(step)  # rows a frame interrupted before its step was counted
         offset = self._append(root["Points"], points)
         self._append(root["NumberOfPoints"], [n])
         for cell in CELL_KINDS:
@@ -213,9 +192,9 @@ class VTKHDFSeries:
         steps.attrs["NSteps"] = np.int64(keep)
 
     def _truncate(self, until):
-        values = self._file["VTKHDF/Steps/Values"][:int(self._file["VTKHDF/Steps"].attrs["NSteps"])]
-        limit = until + 1e-12 * max(1.0, abs(until))
-        self._cut(int(np.searchsorted(values, limit, side="right")))
+        """Keep the steps up to ``until`` (s), and drop the rows of a frame
+        cut short before its step was counted."""
+        self._cut(int(np.searchsorted(self.times, resume_limit(until), side="right")))
         self._file.flush()
 
     @property
