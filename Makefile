@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
 
-.PHONY: demo test install bench validate clean
+.PHONY: demo test install bench validate fuzz clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -32,6 +32,10 @@ bench: $(STAMP)
 
 validate: $(TEST_STAMP)
 	$(BIN)/python benchmarks/validate.py
+
+# the whole fuzz corpus (the suite draws a sample of it): a count of clean cases
+fuzz: $(TEST_STAMP)
+	$(BIN)/python -m tests.fuzzing
 
 clean:
 	rm -rf $(VENV) out .pytest_cache

@@ -9,7 +9,59 @@ The Python interface (docs/api.md)::
     result.parts["pin"].wear_depth.max()
 """
 
+import os as _os
+
 __version__ = "0.1.0"
+
+
+def _numba_cache_dir():
+    """Where numba caches the compiled kernels. By default next to their
+    source (``__pycache__``), else in the user's cache folder; where neither
+    can be written (a system-wide or container install, a user without a
+    writable HOME) numba refuses to import them, so this picks a writable
+    folder first: ``$NUMBA_CACHE_DIR`` if set, else the package folder if
+    writable, else ``meshwear-numba`` in the user's cache or the temporary
+    folder. None when the package folder will do."""
+    if _os.environ.get("NUMBA_CACHE_DIR"):
+        return None
+    here = _os.path.dirname(_os.path.abspath(__file__))
+    if _writable(_os.path.join(here, "kernels")):
+        return None
+    import tempfile
+
+    user = _os.environ.get("XDG_CACHE_HOME") or _os.path.join(_os.path.expanduser("~"), ".cache")
+    for base in (user, tempfile.gettempdir()):
+        folder = _os.path.join(base, f"meshwear-numba-{_os.getuid() if hasattr(_os, 'getuid') else 0}")
+        try:
+            _os.makedirs(folder, exist_ok=True)
+        except OSError:
+            continue
+        if _writable(folder):
+            return folder
+    return None
+
+
+def _writable(folder):
+    """Whether a file can be made in ``folder`` (its __pycache__ for a package
+    folder): tried, as permissions say nothing of a read-only mount."""
+    import tempfile
+
+    target = _os.path.join(folder, "__pycache__")
+    try:
+        _os.makedirs(target, exist_ok=True)
+        with tempfile.TemporaryFile(dir=target):
+            return True
+    except OSError:
+        return False
+
+
+_cache = _numba_cache_dir()
+if _cache is not None:
+    _os.environ["NUMBA_CACHE_DIR"] = _cache
+    import sys as _sys
+
+    if "numba" in _sys.modules:              # numba read its settings already
+        _sys.modules["numba"].config.CACHE_DIR = _cache
 
 #: names of the public interface, imported on first use (numba loads then)
 _API = {"load": "api", "run": "api", "Result": "api", "Part": "api", "Scene": "scene",

@@ -159,6 +159,7 @@ def run(scene, *, out=None, progress=None, vertex_history=False, check_dt=True):
         The run became numerically invalid (the files written so far stay valid).
     """
     from .model import build_model, check_time_step, initial_state
+    from .output.folder import FolderBusy
     from .output.recorder import RunRecorder, summary
     from .simulate import NumericalError, run as run_model
 
@@ -173,7 +174,9 @@ def run(scene, *, out=None, progress=None, vertex_history=False, check_dt=True):
     recorder = None
     if out is not None:
         try:
-            recorder = RunRecorder(out, model)
+            recorder = RunRecorder(out, model, state=state)
+        except FolderBusy as err:
+            raise SceneError(str(out), "", str(err)) from None
         except OSError as err:
             raise SceneError(str(out), "", f"output folder: cannot write there "
                                            f"({err.strerror or err})") from None

@@ -102,11 +102,14 @@ def load(path, model, state):
     if not path.is_file():
         raise SceneError(model.scene.source, "", f"no checkpoint in {path.parent} to resume from "
                          "(run without --resume)")
-    try:
-        data = np.load(path, allow_pickle=False)
+    try:  # every array read now: a damaged file fails here, not half-way through
+        with np.load(path, allow_pickle=False) as npz:
+            data = {name: npz[name] for name in npz.files}
         digest = str(data["digest"])
-    except (OSError, ValueError, KeyError) as err:
-        raise SceneError(model.scene.source, "", f"{path}: unreadable checkpoint ({err})") from None
+    except Exception as err:  # noqa: BLE001 - zip, zlib, npy and key errors alike
+        raise SceneError(model.scene.source, "", f"{path}: damaged or not a checkpoint "
+                         f"({type(err).__name__}); run without --resume to start "
+                         "again") from None
     if digest != scene_digest(model.scene):
         raise SceneError(model.scene.source, "", f"{path} was written for another version of this "
                          "scene or its meshes; run without --resume to start again")

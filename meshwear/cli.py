@@ -6,6 +6,7 @@ sweep with failed runs.
 """
 
 import argparse
+import logging
 import sys
 import time
 from pathlib import Path
@@ -15,6 +16,10 @@ EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL = 0, 2, 3
 EXIT_FAILED_RUNS = 1
 #: a run stopped by SIGTERM or Ctrl-C at a checkpoint (128 + the signal's number)
 EXIT_TERMINATED, EXIT_INTERRUPTED = 143, 130
+
+
+#: numpy's floating-point warnings (turned into errors by :func:`exit_path`)
+FLOATING_POINT = r"(overflow|divide by zero|invalid value|underflow) encountered"
 
 
 class InputError(Exception):
@@ -81,19 +86,15 @@ def main(argv=None):
     p.add_argument("mesh")
     p.add_argument("--units", default="m", help="units of the mesh file (m, mm, cm, um, in)")
     args = parser.parse_args(argv)
+    for stream in (sys.stdout, sys.stderr):   # µ, ³ and the like on an ASCII terminal
+        if hasattr(stream, "reconfigure"):
+            stream.reconfigure(errors="replace")
 
-    import logging
-
-    logging.basicConfig(level=logging.WARNING, format="meshwear: %(message)s")
-    # heavy imports only once the arguments are known
-    from .geometry import MeshError
-    from .output.export import ExportError
-    from .scene import SceneError
-
-    try:
+    def command():
         if args.command == "run":
-            if args.checkpoint_every < 0:
-                raise InputError(f"--checkpoint-every: must be >= 0, got {args.checkpoint_every:g}")
+            if not args.checkpoint_every >= 0:  # NaN too
+                raise InputError(f"--checkpoint-every: must be a number >= 0, got "
+                                 f"{args.checkpoint_every:g}")
             return _run(args.scene, args.out, args.quiet, args.resume, args.checkpoint_every,
                         _overrides(args.set))
         if args.command == "demo":
@@ -110,12 +111,91 @@ def main(argv=None):
         if args.command == "plot":
             return _plot(args)
         return _info(args.mesh, args.units)
+
+    return exit_path(command)
+
+
+def exit_path(command):
+    """Run ``command()`` and return its exit code, mapping what it raises to
+    the command line's codes with one line on stderr: bad input 2, a
+    numerically invalid run 3, Ctrl-C 130. numpy's floating-point warnings
+    are errors inside it (never printed): an overflow while the scene is read
+    and the model built is the scene's fault (2), one in a run the run's (3)."""
+    import warnings
+
+    from .geometry import MeshError
+    from .output.export import ExportError
+    from .scene import SceneError
+    from .simulate import NumericalError
+
+    global _notices
+    outer, _notices = _notices, _Notices()
+    logger = logging.getLogger("meshwear")
+    logger.addHandler(_notices)
+    propagate, logger.propagate = logger.propagate, False
+    try:
+        with warnings.catch_warnings():
+            warnings.filterwarnings("error", FLOATING_POINT, RuntimeWarning)
+            code = command()
+        _notices.show()
+        return code
     except (SceneError, MeshError, InputError, ExportError) as err:
-        print(f"meshwear: error: {err}", file=sys.stderr)
-        return EXIT_INPUT
+        return _fail(f"meshwear: error: {err}", EXIT_INPUT)
+    except NumericalError as err:
+        return _fail(f"meshwear: run stopped: {err}", EXIT_NUMERICAL)
+    except (ArithmeticError, RuntimeWarning) as err:  # overflow, division by zero
+        if _notices.holding:      # the scene is still being read: a figure of it is to blame
+            return _fail(f"meshwear: error: numbers out of range ({err}): a value of the scene "
+                         "is too large or too small for double precision", EXIT_INPUT)
+        return _fail(f"meshwear: run stopped: numbers out of range ({err}): the run left "
+                     "double precision's range", EXIT_NUMERICAL)
+    except MemoryError:
+        return _fail("meshwear: error: out of memory; the scene asks for more than this "
+                     "machine has (fewer steps, frames or faces)", EXIT_INPUT)
     except KeyboardInterrupt:
-        print("meshwear: interrupted; the outputs written so far are valid", file=sys.stderr)
-        return 130
+        return _fail("meshwear: interrupted; the outputs written so far are valid",
+                     EXIT_INTERRUPTED)
+    except BrokenPipeError:               # `meshwear info x | head`
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
+    finally:
+        logger.removeHandler(_notices)
+        logger.propagate = propagate
+        _notices = outer
+
+
+def _fail(line, code):
+    print(line, file=sys.stderr)
+    return code
+
+
+class _Notices(logging.Handler):
+    """meshwear's log records (a mesh cleaned, outputs fewer than asked),
+    held until the input is known good (:meth:`show`, once the model is
+    built) and then printed as ``meshwear: ...`` lines on stderr; dropped
+    when the command fails on its input, so that a refusal is one line."""
+
+    def __init__(self):
+        super().__init__(logging.WARNING)
+        self.held, self.holding = [], True
+
+    def emit(self, record):
+        if self.holding:
+            self.held.append(record)
+        else:
+            print(f"meshwear: {record.getMessage()}", file=sys.stderr)
+
+    def show(self):
+        self.holding = False
+        for record in self.held:
+            self.emit(record)
+        self.held = []
+
+
+#: the notices of the command running (:func:`exit_path`)
+_notices = _Notices()
 
 
 def _set_option(parser):
@@ -136,12 +216,15 @@ def _prepare(scene_path, overrides=()):
 
     scene = load_scene(scene_path, overrides)
     model = build_model(scene)
-    return scene, model, check_time_step(model)
+    limit = check_time_step(model)
+    _notices.show()
+    return scene, model, limit
 
 
 def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=()):
     from . import checkpoint
     from .model import initial_state
+    from .output.folder import FolderBusy
     from .output.recorder import RunRecorder, summary
     from .simulate import NumericalError, run
 
@@ -153,11 +236,14 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=
         wall_before = checkpoint.load(out_dir / checkpoint.FILE_NAME, model, state)
     saver = checkpoint.Checkpointer(out_dir, checkpoint_every, wall_before)
     try:
-        recorder = RunRecorder(out_dir, model, resume_until=state.time if resume else None)
+        recorder = RunRecorder(out_dir, model, resume_until=state.time if resume else None,
+                               state=state)
+    except FolderBusy as err:
+        raise InputError(str(err)) from None
     except OSError as err:  # e.g. -o names an existing file, or a folder we may not write
-        raise InputError(f"{out_dir}: output folder: cannot write there "
+        raise InputError(f"{err.filename or out_dir}: output folder: cannot write there "
                          f"({err.strerror or err})") from None
-    except ValueError as err:  # resuming into files that are not this run's
+    except ValueError as err:  # resuming into files that are not this run's, or damaged
         raise InputError(f"{out_dir}: cannot resume: {err}") from None
     if not resume:
         saver.remove()   # a checkpoint of an earlier run in OUT no longer applies
@@ -196,8 +282,8 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=
         if progress:
             progress.finish()
         recorder.close(summary(model, state, saver.wall_time, "numerical_error", str(err)))
-        print(f"meshwear: run stopped: {err}", file=sys.stderr)
-        print(f"meshwear: outputs up to t = {state.time:.6g} s are in {out_dir}", file=sys.stderr)
+        print(f"meshwear: run stopped: {err}; the outputs up to t = {state.time:.6g} s are in "
+              f"{out_dir}", file=sys.stderr)
         return EXIT_NUMERICAL
     if progress:
         progress.finish()

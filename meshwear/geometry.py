@@ -103,8 +103,15 @@ def load_part(config):
     if config.mesh is not None:
         return load_mesh(config.mesh, config.units)
     s = config.shape
-    return primitive(s.type, size=s.size, radius=s.radius, subdivisions=s.subdivisions,
-                     height=s.height, sections=s.sections)
+    vertices, faces = primitive(s.type, size=s.size, radius=s.radius,
+                                subdivisions=s.subdivisions, height=s.height,
+                                sections=s.sections)
+    source = f"shape {s.type}"
+    check_scale(vertices, source)
+    if len(faces) == 0 or not _doubled_areas(vertices, faces).min() > 0.0:
+        raise MeshError(f"{source}: its dimensions are too unequal for triangles of "
+                        "non-zero area (a radius or size far smaller than the rest)")
+    return vertices, faces
 
 
 def _not_a_file(path):
@@ -160,6 +167,33 @@ def _read_meshio(path):
             np.concatenate(faces).astype(np.int64))
 
 
+#: a part's extent (m) is at least this (a shape or units mistake below)
+MIN_EXTENT = 1e-9
+#: and its coordinates are at most this far from its origin (m)
+MAX_COORDINATE = 1e6
+
+
+def check_scale(vertices, source="<mesh>"):
+    """Refuse (MeshError) vertices that are not finite, farther than
+    :data:`MAX_COORDINATE` from the origin or spanning less than
+    :data:`MIN_EXTENT`: sizes no part has, which would overflow or vanish in
+    the contact's arithmetic (a units mistake, usually)."""
+    vertices = np.asarray(vertices, dtype=np.float64)
+    if not np.all(np.isfinite(vertices)):
+        bad = int((~np.isfinite(vertices).all(axis=1)).sum())
+        raise MeshError(f"{source}: {bad} vertex(es) have NaN or infinite coordinates")
+    if vertices.size == 0:
+        return
+    far = float(np.abs(vertices).max())
+    if far > MAX_COORDINATE:
+        raise MeshError(f"{source}: a vertex lies {far:.3g} m from the origin, beyond "
+                        f"{MAX_COORDINATE:g} m (check the units)")
+    extent = float(np.ptp(vertices, axis=0).max())
+    if extent < MIN_EXTENT:
+        raise MeshError(f"{source}: the part spans {extent:.3g} m, less than {MIN_EXTENT:g} m "
+                        "(check the units)")
+
+
 def clean(vertices, faces, source="<mesh>"):
     """Merge duplicate vertices, drop degenerate and duplicate faces and unused vertices.
 
@@ -184,9 +218,7 @@ def clean(vertices, faces, source="<mesh>"):
     n0, m0 = len(vertices), len(faces)
     if vertices.ndim != 2 or vertices.shape[1] != 3:
         raise MeshError(f"{source}: vertices have shape {vertices.shape}, expected (n, 3)")
-    if not np.all(np.isfinite(vertices)):
-        bad = int((~np.isfinite(vertices).all(axis=1)).sum())
-        raise MeshError(f"{source}: {bad} vertex(es) have NaN or infinite coordinates")
+    check_scale(vertices, source)
     if m0 and (faces.min() < 0 or faces.max() >= n0):
         raise MeshError(f"{source}: faces refer to vertices that do not exist")
     diagonal = float(np.linalg.norm(np.ptp(vertices, axis=0))) if n0 else 0.0
@@ -340,20 +372,39 @@ def primitive(kind, *, size=None, radius=None, subdivisions=3, height=None, sect
     elif kind == "cylinder":
         positive("radius", radius)
         positive("height", height)
-        mesh = trimesh.creation.cylinder(radius=float(radius), height=float(height), sections=int(sections))
+        return _cylinder(float(radius), float(height), int(sections))
     else:
         raise ValueError(f"primitive {kind!r}: expected one of box, sphere, cylinder")
     return _arrays(mesh.vertices, mesh.faces)
+
+
+def _cylinder(radius, height, sections):
+    """A closed cylinder along z: a fan on each cap round its centre, two
+    triangles per side facet (trimesh's layout, without its dropping of cap
+    triangles it finds small: a slender pin stays closed)."""
+    theta = 2.0 * np.pi * np.arange(sections) / sections
+    z = 0.5 * height
+    vertices = np.zeros((2 * sections + 2, 3))
+    vertices[0, 2], vertices[3, 2] = -z, z            # the caps' centres
+    bottom = np.r_[1, 2 * np.arange(1, sections) + 2]
+    top = bottom + 1
+    top[0] = 2
+    for rim, height_z in ((bottom, -z), (top, z)):
+        vertices[rim, 0] = radius * np.cos(theta)
+        vertices[rim, 1] = radius * np.sin(theta)
+        vertices[rim, 2] = height_z
+    b_next, t_next = np.roll(bottom, -1), np.roll(top, -1)
+    faces = np.stack([np.stack([bottom, np.zeros_like(bottom), b_next], axis=1),
+                      np.stack([bottom, b_next, top], axis=1),
+                      np.stack([top, b_next, t_next], axis=1),
+                      np.stack([top, t_next, np.full_like(top, 3)], axis=1)], axis=1)
+    return _arrays(vertices, faces.reshape(-1, 3))
 
 
 def _edge_keys(F, n):
     """(m·3,) int: undirected key min·n + max of edge k = (F[:, k], F[:, k+1])."""
     G = np.roll(F, -1, axis=1)
     return (np.minimum(F, G) * n + np.maximum(F, G)).ravel()
-
-
-# refinement lives in its own module; re-exported here as part of the API
-from .remesh import refine  # noqa: E402,F401  (re-export)
 
 
 # ------------------------------------------------- areas, normals, checks

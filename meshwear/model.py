@@ -6,11 +6,12 @@ writes into, so a step allocates no state. Kernels see only these arrays.
 """
 
 import logging
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import geometry, surfaces
+from . import geometry, remesh, surfaces
 from .kernels.contact import LAW_SLOTS, all_vertices, contact, make_law, rotation_entries
 from .kernels.counter_wear import wear_counter
 from .kernels.laws import code_of
@@ -283,6 +284,8 @@ def build_model(scene):
         law[[LAW_SLOTS.index(name) for name in LAW_SLOTS if "damping" in name]] = 0.0
     for j, (b, config) in enumerate(zip(bodies, scene.bodies)):
         vertex_planes = surfaces.initial_planes(surface_set, b, b.initial_pose, 2.0 * b.radius)[0]
+        # where it was placed, before a quasi-static body is settled on its load
+        _refuse_deep_start(scene, j, b, config, surface_set, vertex_planes)
         if isinstance(b.motion, BalancedMotion):
             if not b.motion.settle(b.initial_pose, b.reference_vertices, b.area_vectors,
                                    plane_array, vertex_planes,
@@ -291,8 +294,6 @@ def build_model(scene):
                                  f"no surface can carry the load of body {config.name!r} along "
                                  f"{list(config.path.free_axis)} (the load pulls it off every "
                                  "surface, or no surface faces it along that axis)")
-        else:
-            _refuse_deep_start(scene, j, b, config, surface_set, vertex_planes)
     # a turning mesh is static in shape if it is a surface of revolution
     # about its axis, against the smallest active-set margin
     margin = min(surfaces.margin_of(scene, b) for b in bodies)
@@ -342,6 +343,12 @@ def auto_time_step(scene, period, limit):
     return min(step, limit)
 
 
+#: most steps a run may take (counts stay exact in float64 times)
+MAX_STEPS = 10**15
+#: fewest steps per cycle cycle jumping accepts (one or two alias an oscillation away)
+MIN_CYCLE_STEPS = 4
+
+
 def _timing(scene, period, limit):
     """``(dt, n_steps, cycle_steps)`` of a run: the step asked (or
     :func:`auto_time_step`) shortened so the duration is whole steps; when
@@ -350,18 +357,32 @@ def _timing(scene, period, limit):
     asked = scene.run.dt
     if asked == "auto":
         asked = auto_time_step(scene, period, limit)
+    key = "run.dt" if scene.run.dt != "auto" else "run.duration"
     if scene.wear.acceleration != "cycle_jump":
-        n_steps = max(1, int(np.ceil(scene.run.duration / asked - 1e-9)))
+        n_steps = _step_count(scene, key, scene.run.duration / asked)
         return scene.run.duration / n_steps, n_steps, 0
     for j, b in enumerate(scene.bodies):
         if b.motion == "free":
             raise SceneError(scene.source, f"body[{j}].motion", "'free' bodies have no cycle to "
                              "jump over; wear.acceleration = 'cycle_jump' needs guided, "
                              "prescribed or fixed bodies")
-    cycle_steps = max(1, int(np.ceil(period / asked - 1e-9)))
+    cycle_steps = _step_count(scene, key, period / asked)
+    if cycle_steps < MIN_CYCLE_STEPS:
+        raise SceneError(scene.source, "run.dt", f"{asked:.6g} s gives {cycle_steps} step(s) "
+                         f"per cycle of {period:.6g} s; cycle jumping needs at least "
+                         f"{MIN_CYCLE_STEPS} to resolve the cycle it extrapolates")
     dt = period / cycle_steps
-    n_steps = max(1, int(round(scene.run.duration / dt)))
+    n_steps = _step_count(scene, "run.duration", scene.run.duration / dt, round)
     return dt, n_steps, cycle_steps
+
+
+def _step_count(scene, key, ratio, rounding=None):
+    """A count of steps ``ratio`` rounded up (or by ``rounding``), at least 1:
+    a SceneError naming ``key`` if it is more than :data:`MAX_STEPS`."""
+    if not ratio <= MAX_STEPS:
+        raise SceneError(scene.source, key, f"the run would take {ratio:.3g} steps, more than "
+                         f"{MAX_STEPS:.0e}; a longer dt or a shorter duration")
+    return max(1, int(rounding(ratio) if rounding else math.ceil(ratio - 1e-9)))
 
 
 def _even_steps(n_steps, count):
@@ -377,7 +398,7 @@ def _build_body(scene, index, body, surface_set):
     key = f"body[{index}]"
     vertices, faces = geometry.load_part(body)
     if body.resolution is not None:
-        vertices, faces = geometry.refine(vertices, faces, body.resolution,
+        vertices, faces = remesh.refine(vertices, faces, body.resolution,
                                           face_mask=_faces_to_refine(scene, body, vertices, faces,
                                                                      surface_set))
     needs_inertia = body.motion in ("free", "guided")

@@ -1,12 +1,15 @@
 """Conforming refinement of triangle meshes (longest-edge bisection).
 
-Plain arrays in and out, as in :mod:`meshwear.geometry`, which re-exports
-:func:`refine`.
+Plain arrays in and out, as in :mod:`meshwear.geometry` (which this module
+builds on and which does not import it).
 """
 
 import numpy as np
 
-from .geometry import MeshError, _arrays, _edge_keys, _edge_lengths
+from .geometry import MeshError, _arrays, _doubled_areas, _edge_keys, _edge_lengths
+
+#: area of the largest triangle whose edges are all <= 1 (equilateral)
+_LARGEST_UNIT_TRIANGLE = np.sqrt(3.0) / 4.0
 
 
 def refine(vertices, faces, resolution, face_mask=None, max_faces=5_000_000):
@@ -34,7 +37,10 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=5_000_000):
         Faces to refine (default all). Children of selected faces stay selected;
         unselected faces are split only where needed to stay conforming.
     max_faces : int
-        Refuse (MeshError) rather than build a larger mesh.
+        Refuse (MeshError) rather than build a larger mesh: at once when the
+        selected area alone needs more faces (a triangle with edges <=
+        ``resolution`` covers sqrt(3)/4 resolution² at most), else as soon as
+        a pass makes more.
 
     Returns
     -------
@@ -47,6 +53,11 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=5_000_000):
     mask = np.ones(len(F), bool) if face_mask is None else np.asarray(face_mask, bool).copy()
     if mask.shape != (len(F),):
         raise ValueError(f"face_mask has shape {mask.shape}, expected ({len(F)},)")
+    area, largest = 0.5 * float(_doubled_areas(V, F[mask]).sum()), _LARGEST_UNIT_TRIANGLE
+    least = area / (largest * resolution**2) if largest * resolution**2 > 0 else float("inf")
+    if not least <= max_faces:
+        raise MeshError(f"refining to resolution {resolution:g} m needs at least {least:.3g} "
+                        f"faces, more than {max_faces}; give a coarser resolution")
     while True:
         lengths = _edge_lengths(V, F)
         need = mask & (lengths.max(axis=1) > resolution)

@@ -26,9 +26,9 @@ from pathlib import Path
 from .geometry import STEP_FORMATS
 from .kernels.laws import LAWS
 from .scene_checks import (SceneError, _boolean, _choice, _coefficient, _did_you_mean,
-                           _direction, _exclusive, _instance, _integer, _name, _nonnegative,
-                           _positive, _real, _set, _set_optional, _show, _vector,
-                           winkler_stiffness)
+                           _direction, _exclusive, _instance, _integer, _length, _name,
+                           _nonnegative, _place, _positive, _real, _set, _set_optional, _show,
+                           _vector, winkler_stiffness)
 
 FORMAT = 1
 MODES = ("dynamic", "quasi-static")
@@ -53,6 +53,14 @@ SURFACE_KEYS = {
     "cylinder": ("radius", "axis", "point", "length", "side", "rotation", "path"),
     "sphere": ("radius", "center", "side", "rotation", "path"),
 }
+#: largest scene file read (bytes)
+MAX_SCENE_BYTES = 16 * 2**20
+#: files of a run's output folder that no part's outputs may take
+RESERVED_NAMES = ("history.csv", "summary.json", "checkpoint.npz")
+#: largest frame and history counts: a file per frame, a row per history time
+MAX_FRAMES, MAX_HISTORY = 100_000, 10_000_000
+#: most facets round a cylinder
+MAX_SECTIONS = 100_000
 #: two directions closer than this (|a x b|) count as parallel
 PARALLEL = 1e-9
 
@@ -67,8 +75,13 @@ def _check_mesh_or_shape(obj):
         if not isinstance(obj.mesh, (str, os.PathLike)):
             raise SceneError("", "mesh", f"expected a file name, got {_show(obj.mesh)}")
         object.__setattr__(obj, "mesh", Path(obj.mesh))
-        if not obj.mesh.is_file():
-            why = "a folder, not a mesh file" if obj.mesh.is_dir() else "file not found"
+        try:
+            found, folder = obj.mesh.is_file(), obj.mesh.is_dir()
+        except (OSError, ValueError) as err:  # a name too long, a NUL byte
+            raise SceneError("", "mesh", f"not a usable file name: {_show(str(obj.mesh))} "
+                                         f"({getattr(err, 'strerror', None) or err})") from None
+        if not found:
+            why = "a folder, not a mesh file" if folder else "file not found"
             raise SceneError("", "mesh", f"{why}: {obj.mesh}")
     else:
         _set(obj, "shape", _instance, ShapeConfig)
@@ -77,8 +90,8 @@ def _check_mesh_or_shape(obj):
         raise SceneError("", "units", "applies to mesh files only; shape dimensions are in metres")
     if obj.mesh is not None and obj.mesh.suffix.lower() in STEP_FORMATS and obj.units != "m":
         raise SceneError("", "units", "a STEP file carries its own length unit; leave units out")
-    _set_optional(obj, "resolution", _positive)
-    _set(obj, "position", _vector)
+    _set_optional(obj, "resolution", _length)
+    _set(obj, "position", _place)
     _set(obj, "orientation", _direction, 4)
     _set_optional(obj, "path", _instance, PathConfig)
 
@@ -111,8 +124,8 @@ class RunConfig:
             _set(self, "dt", _positive)
         if self.dt != "auto" and self.dt > self.duration:
             raise SceneError("", "dt", f"{self.dt!r} s is longer than duration = {self.duration!r} s")
-        _set(self, "frames", _integer, 0)
-        _set(self, "history", _integer, 2)
+        _set(self, "frames", _integer, 0, MAX_FRAMES)
+        _set(self, "history", _integer, 2, MAX_HISTORY)
         _set(self, "gravity", _vector)
         _set(self, "series", _choice, SERIES)
         if self.series == "vtkhdf" and importlib.util.find_spec("h5py") is None:
@@ -150,7 +163,7 @@ class ContactConfig:
     layer: dict | None = None
 
     def __post_init__(self):
-        _set_optional(self, "margin", _positive)
+        _set_optional(self, "margin", _length)
         if self.layer is not None:
             for other in ("stiffness", "stiffness_per_area"):
                 if getattr(self, other) is not None:
@@ -242,10 +255,12 @@ class ShapeConfig:
             _set(self, "size", _vector)
             if min(self.size) <= 0.0:
                 raise SceneError("", "size", f"all three must be > 0, got {_show(self.size)}")
-        _set_optional(self, "radius", _positive)
-        _set_optional(self, "height", _positive)
+            for v in self.size:
+                _length("size", v)
+        _set_optional(self, "radius", _length)
+        _set_optional(self, "height", _length)
         _set(self, "subdivisions", _integer, 0, 7)
-        _set(self, "sections", _integer, 3)
+        _set(self, "sections", _integer, 3, MAX_SECTIONS)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -258,7 +273,7 @@ class Oscillation:
 
     def __post_init__(self):
         _set(self, "axis", _direction)
-        _set(self, "amplitude", _nonnegative)
+        _set(self, "amplitude", _length, True)
         _set(self, "frequency", _positive)
 
 
@@ -271,7 +286,7 @@ class Circle:
     normal: tuple = (0.0, 0.0, 1.0)
 
     def __post_init__(self):
-        _set(self, "radius", _positive)
+        _set(self, "radius", _length)
         _set(self, "frequency", _positive)
         _set(self, "normal", _direction)
 
@@ -315,7 +330,7 @@ class RotationConfig:
     def __post_init__(self):
         _set(self, "axis", _direction)
         _set(self, "rate", _real)
-        _set(self, "center", _vector)
+        _set(self, "center", _place)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -372,9 +387,11 @@ class BodyConfig:
                 raise SceneError("", "angular_velocity", "does not apply to a guided body "
                                                          "(it does not rotate)")
             axis = self.path.free_axis
-            along = sum(v * a for v, a in zip(self.velocity, axis))
-            across = [v - along * a for v, a in zip(self.velocity, axis)]
-            if math.hypot(*across) > 1e-12 * max(1.0, math.hypot(*self.velocity)):
+            scale = max(1.0, *(abs(v) for v in self.velocity))   # no overflow in hypot
+            velocity = [v / scale for v in self.velocity]
+            along = sum(v * a for v, a in zip(velocity, axis))
+            across = [v - along * a for v, a in zip(velocity, axis)]
+            if math.hypot(*across) > 1e-12 * max(1.0 / scale, math.hypot(*velocity)):
                 raise SceneError("", "velocity", "only its component along path.free_axis "
                                                  "applies to a guided body (the path sets the rest)")
         if self.motion in ("prescribed", "fixed"):
@@ -457,25 +474,25 @@ class SurfaceConfig:
                     raise SceneError("", key, "applies to a worn surface only; "
                                               "add wear = true")
             return
-        _set(self, "point", _vector)
-        _set(self, "center", _vector)
+        _set(self, "point", _place)
+        _set(self, "center", _place)
         turn = None if self.rotation is None or self.rotation.rate == 0.0 else self.rotation.axis
         if self.type == "plane":
             _set(self, "normal", _direction)
-            _set_optional(self, "size", _positive)
+            _set_optional(self, "size", _length)
             if turn is not None and _cross_norm(turn, self.normal) > PARALLEL:
                 raise SceneError("", "rotation.axis", f"{_show(turn)}: a plane turns about its "
                                  f"normal {_show(self.normal)} only (a turning disc)")
             return
         if self.radius is None:
             raise SceneError("", "radius", f"missing; a {self.type} needs a radius (m)")
-        _set(self, "radius", _positive)
+        _set(self, "radius", _length)
         _set(self, "side", _choice, SIDES)
         if self.type == "cylinder":
             if self.axis is None:
                 raise SceneError("", "axis", "missing; a cylinder needs the direction of its axis")
             _set(self, "axis", _direction)
-            _set_optional(self, "length", _positive)
+            _set_optional(self, "length", _length)
             if (turn is not None and self.length is None
                     and _cross_norm(turn, self.axis) > PARALLEL):
                 raise SceneError("", "rotation.axis", f"{_show(turn)}: an infinite cylinder "
@@ -541,7 +558,7 @@ class Scene:
         # each name owns the output paths <name>.pvd, <name>.vtkhdf and <name>/; no two may
         # clash, nor with history.csv / summary.json, ignoring case (as
         # Windows and macOS file systems do)
-        taken = {"history.csv": "history.csv", "summary.json": "summary.json"}
+        taken = {name: name for name in RESERVED_NAMES}
         names = {}
         for key, item, cls in items:
             if not isinstance(item, cls):
@@ -646,7 +663,12 @@ def load_scene(path, overrides=()) -> Scene:
     path = Path(path)
     source = str(path)
     try:
-        text = path.read_bytes().decode("utf-8-sig")
+        with open(path, "rb") as file:
+            raw = file.read(MAX_SCENE_BYTES + 1)
+        if len(raw) > MAX_SCENE_BYTES:
+            raise SceneError(source, "", f"larger than {MAX_SCENE_BYTES // 2**20} MiB; a scene "
+                                         "file names its meshes, it does not hold them")
+        text = raw.decode("utf-8-sig")
     except FileNotFoundError:
         raise SceneError(source, "", "file not found") from None
     except IsADirectoryError:
@@ -657,6 +679,9 @@ def load_scene(path, overrides=()) -> Scene:
         raise SceneError(source, "", "not a UTF-8 text file") from None
     try:
         data = tomllib.loads(text)
+    except RecursionError:
+        raise SceneError(source, "", "TOML syntax error: tables or lists nested too "
+                                     "deeply") from None
     except tomllib.TOMLDecodeError as err:
         message = str(err)
         where = re.search(r"\s*\(at (line \d+, column \d+|end of document)\)$", message)

@@ -11,6 +11,9 @@ import numbers
 import re
 
 _SAFE_NAME = re.compile(r"[A-Za-z0-9_.\-]+")
+#: longest part name: its frames are ``<name>/<name>_00000.vtp``, within the
+#: 255 bytes a file name may have on common file systems, with room to spare
+NAME_LENGTH = 100
 
 
 class SceneError(ValueError):
@@ -77,6 +80,29 @@ def _nonnegative(key, value):
     return value
 
 
+#: longest length and farthest coordinate a scene may give (m): beyond
+#: them, squares and products of lengths leave double precision's range
+MAX_LENGTH = 1e6
+
+
+def _length(key, value, zero=False):
+    """A length in metres: > 0 (>= 0 with ``zero``) and at most :data:`MAX_LENGTH`."""
+    value = _nonnegative(key, value) if zero else _positive(key, value)
+    if value > MAX_LENGTH:
+        raise SceneError("", key, f"{value!r} m is longer than {MAX_LENGTH:g} m "
+                                  "(check the units: metres)")
+    return value
+
+
+def _place(key, value):
+    """A point (m): three numbers, none farther than :data:`MAX_LENGTH` from 0."""
+    value = _vector(key, value)
+    if max(abs(v) for v in value) > MAX_LENGTH:
+        raise SceneError("", key, f"{_show(value)} lies farther than {MAX_LENGTH:g} m from "
+                                  "the origin (check the units: metres)")
+    return value
+
+
 def _boolean(key, value):
     if not isinstance(value, bool):
         raise SceneError("", key, f"expected true or false, got {_show(value)}")
@@ -118,18 +144,25 @@ def _vector(key, value, n=3):
 def _direction(key, value, n=3):
     """Unit vector (or unit quaternion for n = 4) along a non-zero ``value``."""
     value = _vector(key, value, n)
-    norm = math.hypot(*value)
-    if norm == 0.0:
+    largest = max(abs(v) for v in value)
+    if largest == 0.0:
         raise SceneError("", key, f"must be non-zero, got {_show(value)}")
+    norm = math.hypot(*value)
+    if not 1e-150 < norm < math.inf:       # 1e308 components, subnormal ones: scaled first
+        value = [v / largest for v in value]
+        norm = math.hypot(*value)
     return tuple(v / norm for v in value)
 
 
 def _name(key, value):
     if not isinstance(value, str):
         raise SceneError("", key, f"expected a string, got {_show(value)}")
-    if not _SAFE_NAME.fullmatch(value) or set(value) == {"."}:
-        raise SceneError("", key, f"{value!r} is not usable as a file name; use letters, "
-                                  "digits, '_', '-' and '.'")
+    if not _SAFE_NAME.fullmatch(value) or value.startswith("."):
+        raise SceneError("", key, f"{_show(value)} is not usable as a file name; use letters, "
+                                  "digits, '_', '-' and '.' (not first)")
+    if len(value) > NAME_LENGTH:
+        raise SceneError("", key, f"{_show(value)} is {len(value)} characters long; at most "
+                                  f"{NAME_LENGTH}")
     return value
 
 

@@ -25,7 +25,7 @@ import trimesh
 import vtk
 from vtk.util.numpy_support import vtk_to_numpy
 
-from meshwear import geometry
+from meshwear import geometry, remesh
 from meshwear.cli import main
 
 #: docs/outputs.md: history.csv starts with these columns, in this order
@@ -457,7 +457,7 @@ def test_good_run_frames(good_run, body):
 
 def test_good_run_frame_0_is_the_reference_mesh_placed_in_the_world(good_run):
     vertices, faces = geometry.primitive("box", size=BLOCK_SIZE)
-    vertices, faces = geometry.refine(vertices, faces, BLOCK_RESOLUTION)
+    vertices, faces = remesh.refine(vertices, faces, BLOCK_RESOLUTION)
     turned = np.column_stack([-vertices[:, 1], vertices[:, 0], vertices[:, 2]])   # 90° about z
     points = vtk_to_numpy(read_vtp(good_run[0] / "block" / "block_00000.vtp").GetPoints().GetData())
     np.testing.assert_allclose(points, turned + BLOCK_POSITION, rtol=0, atol=1e-12)

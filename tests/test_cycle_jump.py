@@ -49,8 +49,14 @@ def test_growth_and_end_bounds():
 def test_implicit_jumps_have_no_stability_bound():
     rate = np.array([1e-9, 2e-9, 1e-12])
     pen = np.array([1e-6, 1e-6, 1e-9])
+    # the explicit bound would cut the jump short (the stiff third vertex)
+    jump, which = choose_jump(rate, rate.copy(), 1.0, pen, 0.01, 10_000, 10_000)
+    assert which == "stability" and jump < 10_000
+    # implicit: only growth and the run's end bound it
+    jump, which = choose_jump(rate, rate.copy(), 1.0, pen, 0.01, 10_000, 10**9, stability=False)
+    assert (jump, which) == (int(GROWTH * 10_000 + 1), "growth")
     jump, which = choose_jump(rate, rate.copy(), 1.0, pen, 0.01, 10_000, 10_000, stability=False)
-    assert which == "growth" and jump == int(GROWTH * 10_000 + 1) or jump == 10_000
+    assert (jump, which) == (10_000, "end")
 
 
 # ---------------------------------------------------------------- against resolved runs

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from meshwear import geometry
+from meshwear import geometry, remesh
 from meshwear.geometry import MeshError
 
 
@@ -216,7 +216,7 @@ def test_mesh_info(tmp_path):
 
 def test_refine_whole_box():
     vertices, faces = geometry.primitive("box", size=[0.01, 0.02, 0.03])
-    v, f = geometry.refine(vertices, faces, 2e-3)
+    v, f = remesh.refine(vertices, faces, 2e-3)
     check_arrays(v, f)
     assert edge_lengths(v, f).max() <= 2e-3
     assert area(v, f) == pytest.approx(area(vertices, faces), rel=1e-12)
@@ -229,7 +229,7 @@ def test_refine_whole_box():
 def test_refine_bottom_only_stays_conforming():
     vertices, faces = geometry.primitive("box", size=[0.01, 0.02, 0.03])
     bottom = geometry.face_normals(vertices, faces)[:, 2] < -0.99
-    v, f = geometry.refine(vertices, faces, 1e-3, face_mask=bottom)
+    v, f = remesh.refine(vertices, faces, 1e-3, face_mask=bottom)
     assert trimesh.Trimesh(v, f, process=False).is_watertight                  # no T-junctions
     assert watertight(v, f)
     on_bottom = np.all(np.isclose(v[f][:, :, 2], -0.015, rtol=0, atol=1e-15), axis=1)
@@ -247,7 +247,7 @@ def test_refine_long_thin_triangles_economically():
     length, width, resolution = 0.1, 1e-3, 2.5e-4
     vertices = np.array([[0, 0, 0], [length, 0, 0], [length, width, 0], [0, width, 0]], float)
     faces = np.array([[0, 1, 2], [0, 2, 3]])
-    v, f = geometry.refine(vertices, faces, resolution)
+    v, f = remesh.refine(vertices, faces, resolution)
     assert edge_lengths(v, f).max() <= resolution
     assert area(v, f) == pytest.approx(length * width, rel=1e-12)
     # right isosceles triangles with hypotenuse = resolution: area/(resolution²/4) faces;
@@ -265,19 +265,23 @@ def test_refine_long_thin_triangles_economically():
 
 def test_refine_leaves_fine_meshes_alone_and_checks_inputs():
     vertices, faces = geometry.primitive("sphere", radius=1.0, subdivisions=1)
-    v, f = geometry.refine(vertices, faces, 10.0)
+    v, f = remesh.refine(vertices, faces, 10.0)
     np.testing.assert_array_equal(f, faces)
     with pytest.raises(ValueError, match="resolution"):
-        geometry.refine(vertices, faces, 0.0)
+        remesh.refine(vertices, faces, 0.0)
     with pytest.raises(ValueError, match="face_mask"):
-        geometry.refine(vertices, faces, 0.1, face_mask=np.ones(3, bool))
-    with pytest.raises(MeshError, match="more than 1000 faces"):
-        geometry.refine(vertices, faces, 1e-3, max_faces=1000)
+        remesh.refine(vertices, faces, 0.1, face_mask=np.ones(3, bool))
+    # refused before any work: 11.7 m² in triangles of at most 0.433 mm² is 2.7e7 faces
+    with pytest.raises(MeshError, match=r"at least 2.69e\+07 faces, more than 1000;"):
+        remesh.refine(vertices, faces, 1e-3, max_faces=1000)
+    # and, past that lower bound (299 faces), when a pass makes more
+    with pytest.raises(MeshError, match="needs more than 400 faces"):
+        remesh.refine(vertices, faces, 0.3, max_faces=400)
 
 
 def test_refine_curved_surface_closed():
     vertices, faces = geometry.primitive("cylinder", radius=0.01, height=0.05, sections=16)
-    v, f = geometry.refine(vertices, faces, 2e-3)
+    v, f = remesh.refine(vertices, faces, 2e-3)
     assert watertight(v, f) and edge_lengths(v, f).max() <= 2e-3
     assert area(v, f) == pytest.approx(area(vertices, faces), rel=1e-12)
 
@@ -286,7 +290,7 @@ def test_refine_curved_surface_closed():
 
 def test_inverted_faces_found():
     vertices, faces = geometry.primitive("box", size=1.0)
-    vertices, faces = geometry.refine(vertices, faces, 0.3)
+    vertices, faces = remesh.refine(vertices, faces, 0.3)
     reference = geometry.face_normals(vertices, faces)
     assert len(geometry.inverted_faces(reference, vertices, faces)) == 0
     # drag one bottom vertex sideways past its neighbours: part of its fan flips

@@ -8,6 +8,8 @@ from pathlib import Path
 
 from ..wear import error_estimate
 from .fields import body_quantities, body_totals, part_quantities
+from .export import SERIES_SUFFIXES
+from .folder import FolderLock, check_writable
 from .tables import HISTORY_COLUMNS, HistoryWriter, write_json_atomic
 from .vtk import PVDSeries
 
@@ -37,11 +39,37 @@ class RunRecorder:
     resume_until : float, optional
         Continue the files of a stopped run, keeping what it wrote up to this
         time (s) and dropping the rest.
+    state : meshwear.model.State, optional
+        The run's first state: ``summary.json`` says ``"running"`` from the
+        start (a run killed outright leaves that, not an older run's "ok").
+
+    Raises
+    ------
+    meshwear.output.folder.FolderBusy
+        Another run writes to ``out_dir`` (held from here to :meth:`finish`).
+    OSError
+        A folder or file that cannot be written: nothing replaced yet.
+    ValueError
+        Resuming into files that are not the stopped run's, or damaged.
     """
 
-    def __init__(self, out_dir, model, resume_until=None):
+    def __init__(self, out_dir, model, resume_until=None, state=None):
         self.out_dir = Path(out_dir)
         self.out_dir.mkdir(parents=True, exist_ok=True)
+        self.lock = FolderLock(self.out_dir)
+        try:
+            self._open(model, resume_until, state)
+        except BaseException:
+            self.lock.release()
+            raise
+
+    def _open(self, model, resume_until, state):
+        names = [part.name for part in list(model.bodies) + list(model.surfaces.slots)]
+        check_writable(self.out_dir, [f"{n}{suffix}" for n in names for suffix in SERIES_SUFFIXES]
+                       + ["history.csv", "summary.json", "checkpoint.npz"], names)
+        if state is not None:   # a run killed from now on is not mistaken for a finished one
+            write_json_atomic(self.out_dir / "summary.json",
+                              summary(model, state, 0.0, "running", "the run has not ended"))
         Series = series_class(model)
         self.series = {b.name: Series(self.out_dir, b.name, b.faces, resume_until)
                        for b in model.bodies}
@@ -84,17 +112,18 @@ class RunRecorder:
                                 "orientation": q["orientation"]})
 
     def finish(self):
-        """Close the history and every series."""
+        """Close the history and every series, and free the folder."""
         self.history.close()
         for series in list(self.series.values()) + list(self.parts.values()):
             series.close()
         for _, _, series in self.moving.values():
             series.close()
+        self.lock.release()
 
     def close(self, summary):
-        """:meth:`finish`, and write ``summary.json``."""
-        self.finish()
+        """Write ``summary.json`` and :meth:`finish`."""
         write_json_atomic(self.out_dir / "summary.json", summary)
+        self.finish()
 
 
 def history_rows(model, state):

@@ -46,12 +46,20 @@ class HistoryWriter:
 
     def _keep_rows_until(self, time):
         """Resuming: drop the rows written after ``time`` (s) by the stopped run."""
-        with open(self.path, newline="", encoding="utf-8") as f:
-            rows = list(csv.reader(f))
+        try:
+            with open(self.path, newline="", encoding="utf-8") as f:
+                rows = list(csv.reader(f))
+        except FileNotFoundError:
+            raise ValueError(f"{self.path}: the stopped run's history is missing") from None
+        except (csv.Error, UnicodeDecodeError) as err:
+            raise ValueError(f"{self.path}: damaged history ({err})") from None
         if not rows or tuple(rows[0]) != self.columns:
             raise ValueError(f"{self.path}: not the history of this run (columns differ)")
         limit = time + 1e-12 * max(1.0, abs(time))
-        kept = [r for r in rows[1:] if len(r) == len(self.columns) and float(r[0]) <= limit]
+        try:
+            kept = [r for r in rows[1:] if len(r) == len(self.columns) and float(r[0]) <= limit]
+        except ValueError as err:
+            raise ValueError(f"{self.path}: damaged history ({err})") from None
         lines = [",".join(self.columns)] + [",".join(r) for r in kept]
         write_text_atomic(self.path, "\n".join(lines) + "\n")
 

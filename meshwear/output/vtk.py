@@ -11,6 +11,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from .folder import ensure_space
 from .tables import write_text_atomic
 
 
@@ -82,6 +83,7 @@ class PVDSeries:
         # an older run's series of this name in the other format
         (self.out_dir / f"{name}.vtkhdf").unlink(missing_ok=True)
         self._closed = False
+        self._last_size = 0
         self._write_pvd()           # an empty collection replaces any older series
 
     def write_frame(self, time, points, point_data, field_data=None):
@@ -118,7 +120,10 @@ class PVDSeries:
         index = len(self._entries)
         relative = f"{self.name}/{self.name}_{index:05d}.vtp"
         path = self.out_dir / relative
+        # as large as the last frame, or (the first) as its arrays uncompressed
+        ensure_space(self.frame_dir, self._last_size or mesh.actual_memory_size * 1024)
         mesh.save(path, binary=True, compression="zlib")
+        self._last_size = path.stat().st_size
         self._entries.append((float(time), relative))
         self._write_pvd()
         return path
@@ -127,10 +132,13 @@ class PVDSeries:
         import xml.etree.ElementTree as ET
 
         if not self.pvd_path.is_file():
-            return []
+            raise ValueError(f"{self.pvd_path}: the stopped run's series is missing")
         limit = resume_limit(until)
-        entries = [(float(d.get("timestep")), d.get("file"))
-                   for d in ET.parse(self.pvd_path).getroot().iter("DataSet")]
+        try:
+            entries = [(float(d.get("timestep")), d.get("file"))
+                       for d in ET.parse(self.pvd_path).getroot().iter("DataSet")]
+        except (ET.ParseError, TypeError, ValueError) as err:
+            raise ValueError(f"{self.pvd_path}: damaged series file ({err})") from None
         return [(t, f) for t, f in entries if t <= limit and (self.out_dir / f).is_file()]
 
     def _write_pvd(self):

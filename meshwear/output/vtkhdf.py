@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .folder import ensure_space
 from .vtk import frame_arrays, remove_frames, resume_limit, series_name_and_faces
 
 #: how to install the writer, named by the error when h5py is missing
@@ -59,9 +60,14 @@ class VTKHDFSeries:
         self.faces = faces
         self.path = self.out_dir / f"{name}{self.suffix}"
         self._closed = False
-        if resume_until is not None and self.path.is_file():
-            self._file = h5py.File(self.path, "r+")
-            self._truncate(resume_until)
+        if resume_until is not None:
+            if not self.path.is_file():
+                raise ValueError(f"{self.path}: the stopped run's series is missing")
+            try:
+                self._file = h5py.File(self.path, "r+")
+                self._truncate(resume_until)
+            except (OSError, KeyError) as err:
+                raise ValueError(f"{self.path}: damaged series file ({err})") from None
         else:
             # an older run's .pvd series of this name
             (self.out_dir / f"{name}.pvd").unlink(missing_ok=True)
@@ -128,6 +134,7 @@ class VTKHDFSeries:
             raise RuntimeError(f"series {self.name!r} is closed")
         points, data = frame_arrays(points, self.faces, point_data)
         n = len(points)
+        ensure_space(self.out_dir, points.nbytes + sum(v.nbytes for v in data.values()))
         root, steps = self._file["VTKHDF"], self._file["VTKHDF/Steps"]
         step = int(steps.attrs["NSteps"])
         fields = {"TimeValue": np.array([float(time)])}

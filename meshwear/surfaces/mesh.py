@@ -10,7 +10,7 @@ measured when the run is built, is checked against the active-set margin.
 import fcl
 import numpy as np
 
-from .. import geometry
+from .. import geometry, remesh
 from ..kernels.counter import MESH
 from ..kernels.laws import name_of as code_name
 from ..kernels.nearest import (build_grid, corner_normals, face_frames, nearest_planes_parallel,
@@ -29,7 +29,10 @@ MAX_SAMPLES = 200_000
 
 
 def bvh(vertices, faces):
-    """An fcl BVH of a triangle mesh."""
+    """An fcl BVH of a triangle mesh (MeshError for one without faces: fcl
+    would crash)."""
+    if len(faces) == 0 or len(vertices) == 0:
+        raise geometry.MeshError("no triangle faces")
     model = fcl.BVHModel()
     model.beginModel(len(vertices), len(faces))
     model.addSubModel(vertices, faces)
@@ -75,7 +78,7 @@ class MeshSurface(CounterSurface):
         """
         vertices, faces = geometry.load_part(config)
         if config.resolution is not None:
-            vertices, faces = geometry.refine(vertices, faces, config.resolution)
+            vertices, faces = remesh.refine(vertices, faces, config.resolution)
         return cls(config.name, vertices, faces, config.position, config.orientation,
                    config.rotation, config.path, config.smooth_normals)
 

@@ -1,0 +1,225 @@
+"""The fuzz corpus: bad and extreme inputs made by mutating the example
+scenes key by key and their meshes, and the probe that puts one through
+scene loading, model building, the outputs' set-up and a few steps, the
+way ``meshwear run`` does (its exit path included).
+
+Used by tests/test_fuzz.py (Hypothesis draws from it, within a minute) and
+by ``make fuzz`` (``python -m tests.fuzzing``: every case, with a count of
+the clean ones)::
+
+    .venv/bin/python -m tests.fuzzing [--scenes pin_on_disc cube_toss] [--limit N]
+
+A case is clean when it ends with exit 0 and nothing on stderr but
+``meshwear:`` notices (a valid input), or with exit 2 or 3 and exactly one
+``meshwear:`` line on stderr, within a second for a refusal; anything else (a traceback, a warning, a second line, a hang) is a
+finding.
+"""
+
+import argparse
+import contextlib
+import io
+import math
+import sys
+import tempfile
+import time
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+#: example scenes small enough to probe many times (seconds each, at most)
+SCENES = ("pin_on_disc", "cube_toss", "reciprocating_block", "sphere_on_flat_fretting",
+          "pin_on_worn_disc", "pin_on_turning_disc", "validation/flat_pin",
+          "validation/jenkins_quasi_static", "block_on_ring")
+#: steps a probe takes (the rest of a run is the same loop)
+PROBE_STEPS = 20
+
+HUGE, TINY = 1.7e308, 5e-324
+#: values put in place of any key
+SCALARS = (0, -1, -0.0, 1, 0.5, math.nan, math.inf, -math.inf, 1e308, -1e308, 1e-308,
+           TINY, 1e-300, 1e21, 2 ** 63, -(2 ** 70), True, "", "x" * 300, "nan", "../x",
+           "checkpoint.npz", [], {}, [1.0, 2.0], [[1.0]], {"a": 1})
+#: values put in place of a list of numbers
+VECTORS = ([0.0, 0.0, 0.0], [HUGE, HUGE, HUGE], [math.nan, 0.0, 0.0], [1e-320, 0.0, 0.0],
+           [1.0, 2.0], [1.0, 0.0, 0.0, 0.0], ["a", 1.0, 2.0], [HUGE] * 4,
+           [-1e308, 1e308, 0.0], [1e300, 1e300, 1e300], [0.0, 0.0, 1e-300])
+
+
+def leaf_keys(data, prefix=""):
+    """Every leaf key of parsed TOML ``data`` by its dotted name (the names
+    ``--set`` takes: ``body[0].path.circle.radius``), with its value."""
+    for key, value in data.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            yield from leaf_keys(value, name + ".")
+        elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+            for i, item in enumerate(value):
+                yield from leaf_keys(item, f"{name}[{i}].")
+        else:
+            yield name, value
+
+
+def scene_cases(stems=SCENES):
+    """``(scene path, key, value)`` for every key of every scene and every
+    value of :data:`SCALARS` (and :data:`VECTORS` for a list of numbers)."""
+    for stem in stems:
+        path = EXAMPLES / f"{stem}.toml"
+        data = tomllib.loads(path.read_text())
+        for key, value in leaf_keys(data):
+            values = SCALARS + (VECTORS if isinstance(value, list) else ())
+            for bad in values:
+                yield path, key, bad
+
+
+def mesh_cases():
+    """``(name, bytes)`` of broken and extreme mesh files:
+    terms: truncated, garbage, bad indices, extreme coordinates."""
+    good = (ROOT / "meshes" / "cube_20mm.stl").read_bytes()
+    tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+    return [
+        ("empty.stl", b""),
+        ("truncated.stl", good[: len(good) // 2]),
+        ("garbage.stl", bytes(range(256)) * 8),
+        ("garbage.obj", b"\x00\xff" * 500),
+        ("zero_index.obj", (tri + "f 0 1 2\nf 1 2 3\n").encode()),
+        ("far_index.obj", (tri + "f 1 2 99\n").encode()),
+        ("negative_index.obj", (tri + "f -9 1 2\n").encode()),
+        ("huge.obj", ("v 1e308 0 0\nv -1e308 0 0\nv 0 1e308 0\nv 0 0 1e308\n"
+                      "f 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n").encode()),
+        ("nan.obj", ("v nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                     "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n").encode()),
+        ("flat.obj", (tri.replace("v 0 0 1", "v 1 1 0") + "f 1 2 3\nf 1 3 4\n").encode()),
+        ("one_face.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+        ("no_faces.obj", tri.encode()),
+        ("text.ply", b"ply\nformat ascii 1.0\nelement vertex 99\nend_header\n1 2 3\n"),
+    ]
+
+
+class Outcome:
+    """What a probe did: ``code`` (0, 2, 3, or None for an escaped
+    exception), ``stderr``, ``seconds``, ``error`` (the escaped exception)."""
+
+    def __init__(self, code, stderr, seconds, error=None):
+        self.code, self.stderr, self.seconds, self.error = code, stderr, seconds, error
+
+    @property
+    def clean(self):
+        lines = self.stderr.splitlines()
+        if self.error is not None:
+            return False
+        if self.code == 0:        # a valid input: its notices only
+            return all(line.startswith("meshwear: ") and "Warning" not in line
+                       for line in lines)
+        return self.code in (2, 3) and len(lines) == 1 and lines[0].startswith("meshwear: ")
+
+    def __repr__(self):
+        what = (f"{type(self.error).__name__}: {self.error}" if self.error is not None
+                else self.stderr.strip()[:300])
+        return f"exit {self.code} in {self.seconds:.2f} s: {what}"
+
+
+def probe(scene_path, overrides=(), steps=PROBE_STEPS):
+    """One input through what ``meshwear run`` does first, in this process:
+    load, build, the dt check, the outputs' set-up and first frame, and
+    ``steps`` steps, inside the command line's exit path."""
+    from meshwear import cli
+
+    def work():
+        from meshwear import stepper
+        from meshwear.model import initial_state
+        from meshwear.output.recorder import RunRecorder
+
+        scene, model, _ = cli._prepare(scene_path, overrides)
+        state = initial_state(model)
+        with tempfile.TemporaryDirectory() as out:
+            recorder = RunRecorder(Path(out) / "run", model)
+            recorder.on_frame(model, state)
+            stepper.advance(model, state, min(model.n_steps, steps))
+            from meshwear.simulate import check
+            check(model, state, [b.reference_face_normals for b in model.bodies])
+            recorder.finish()
+        return 0
+
+    stderr = io.StringIO()
+    start = time.perf_counter()
+    exit_path = getattr(cli, "exit_path", None) or _exit_path_before
+    try:
+        with contextlib.redirect_stderr(stderr):
+            code = exit_path(work)
+    except BaseException as err:  # noqa: BLE001 - a finding, reported
+        return Outcome(None, stderr.getvalue(), time.perf_counter() - start, err)
+    return Outcome(code, stderr.getvalue(), time.perf_counter() - start)
+
+
+def _exit_path_before(command):
+    """What ``meshwear run`` did with errors before it had one exit path (for
+    the before/after count of ``make fuzz`` on an older checkout)."""
+    import logging
+
+    from meshwear.cli import InputError
+    from meshwear.geometry import MeshError
+    from meshwear.scene import SceneError
+    from meshwear.simulate import NumericalError
+
+    logging.basicConfig(level=logging.WARNING, format="meshwear: %(message)s", force=True)
+    try:
+        return command()
+    except (SceneError, MeshError, InputError) as err:
+        print(f"meshwear: error: {err}", file=sys.stderr)
+        return 2
+    except NumericalError as err:
+        print(f"meshwear: run stopped: {err}", file=sys.stderr)
+        return 3
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description="run the fuzz corpus, count clean cases")
+    parser.add_argument("--scenes", nargs="*", default=list(SCENES))
+    parser.add_argument("--start", type=int, default=0, help="first case (0-based)")
+    parser.add_argument("--limit", type=int, default=None, help="cases at most")
+    parser.add_argument("-v", "--verbose", action="store_true", help="name each case first")
+    parser.add_argument("--slow", type=float, default=1.0,
+                        help="seconds beyond which a refused case counts as slow")
+    args = parser.parse_args(argv)
+    cases = list(scene_cases(args.scenes))[args.start:][: args.limit]
+    clean = slow = 0
+    findings = {}
+    start = time.perf_counter()
+    for n, (path, key, value) in enumerate(cases, 1):
+        if args.verbose:
+            print(f"{n - 1 + args.start}: {path.stem} {key} = {value!r}"[:200], file=sys.stderr,
+                  flush=True)
+        outcome = probe(path, ((key, value),))
+        ok = outcome.clean
+        if ok and outcome.code != 0 and outcome.seconds > args.slow:
+            slow += 1
+            ok = False
+        clean += ok
+        if not ok:
+            kind = (type(outcome.error).__name__ if outcome.error is not None
+                    else f"exit {outcome.code}, {len(outcome.stderr.splitlines())} lines")
+            findings.setdefault(kind, []).append((path.stem, key, value, outcome))
+        if n % 100 == 0:
+            print(f"  {n} of {len(cases)}: {clean} clean", file=sys.stderr, flush=True)
+    with tempfile.TemporaryDirectory() as folder:
+        for name, content in mesh_cases():
+            mesh = Path(folder) / name
+            mesh.write_bytes(content)
+            outcome = probe(EXAMPLES / "cube_toss.toml", (("body[0].mesh", str(mesh)),))
+            cases.append(mesh)
+            if outcome.clean:
+                clean += 1
+            else:
+                findings.setdefault("mesh", []).append(("cube_toss", "mesh", name, outcome))
+    for kind, items in sorted(findings.items()):
+        print(f"{kind}: {len(items)}")
+        for stem, key, value, outcome in items[:60]:
+            shown = repr(value)[:40]
+            print(f"  {stem} {key} = {shown}: {outcome!r}"[:400])
+    print(f"{clean} of {len(cases)} cases clean ({slow} slow refusals) in "
+          f"{time.perf_counter() - start:.0f} s")
+    return 0 if clean == len(cases) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
