@@ -25,31 +25,26 @@ def _numba_cache_dir():
     if _os.environ.get("NUMBA_CACHE_DIR"):
         return None
     here = _os.path.dirname(_os.path.abspath(__file__))
-    if _writable(_os.path.join(here, "kernels")):
+    if _writable(_os.path.join(here, "kernels", "__pycache__")):
         return None
     import tempfile
 
     user = _os.environ.get("XDG_CACHE_HOME") or _os.path.join(_os.path.expanduser("~"), ".cache")
     for base in (user, tempfile.gettempdir()):
-        folder = _os.path.join(base, f"meshwear-numba-{_os.getuid() if hasattr(_os, 'getuid') else 0}")
-        try:
-            _os.makedirs(folder, exist_ok=True)
-        except OSError:
-            continue
+        folder = _os.path.join(base, f"meshwear-numba-{getattr(_os, 'getuid', lambda: 0)()}")
         if _writable(folder):
             return folder
     return None
 
 
 def _writable(folder):
-    """Whether a file can be made in ``folder`` (its __pycache__ for a package
-    folder): tried, as permissions say nothing of a read-only mount."""
+    """Whether a file can be made in ``folder`` (made if missing): tried, as
+    permissions say nothing of a read-only mount."""
     import tempfile
 
-    target = _os.path.join(folder, "__pycache__")
     try:
-        _os.makedirs(target, exist_ok=True)
-        with tempfile.TemporaryFile(dir=target):
+        _os.makedirs(folder, exist_ok=True)
+        with tempfile.TemporaryFile(dir=folder):
             return True
     except OSError:
         return False

@@ -53,8 +53,9 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=5_000_000):
     mask = np.ones(len(F), bool) if face_mask is None else np.asarray(face_mask, bool).copy()
     if mask.shape != (len(F),):
         raise ValueError(f"face_mask has shape {mask.shape}, expected ({len(F)},)")
-    area, largest = 0.5 * float(_doubled_areas(V, F[mask]).sum()), _LARGEST_UNIT_TRIANGLE
-    least = area / (largest * resolution**2) if largest * resolution**2 > 0 else float("inf")
+    area = 0.5 * float(_doubled_areas(V, F[mask]).sum())
+    cell = _LARGEST_UNIT_TRIANGLE * resolution**2     # 0.0 for a subnormal resolution
+    least = area / cell if cell > 0.0 else float("inf")
     if not least <= max_faces:
         raise MeshError(f"refining to resolution {resolution:g} m needs at least {least:.3g} "
                         f"faces, more than {max_faces}; give a coarser resolution")

@@ -142,34 +142,12 @@ def probe(scene_path, overrides=(), steps=PROBE_STEPS):
 
     stderr = io.StringIO()
     start = time.perf_counter()
-    exit_path = getattr(cli, "exit_path", None) or _exit_path_before
     try:
         with contextlib.redirect_stderr(stderr):
-            code = exit_path(work)
+            code = cli.exit_path(work)
     except BaseException as err:  # noqa: BLE001 - a finding, reported
         return Outcome(None, stderr.getvalue(), time.perf_counter() - start, err)
     return Outcome(code, stderr.getvalue(), time.perf_counter() - start)
-
-
-def _exit_path_before(command):
-    """What ``meshwear run`` did with errors before it had one exit path (for
-    the before/after count of ``make fuzz`` on an older checkout)."""
-    import logging
-
-    from meshwear.cli import InputError
-    from meshwear.geometry import MeshError
-    from meshwear.scene import SceneError
-    from meshwear.simulate import NumericalError
-
-    logging.basicConfig(level=logging.WARNING, format="meshwear: %(message)s", force=True)
-    try:
-        return command()
-    except (SceneError, MeshError, InputError) as err:
-        print(f"meshwear: error: {err}", file=sys.stderr)
-        return 2
-    except NumericalError as err:
-        print(f"meshwear: run stopped: {err}", file=sys.stderr)
-        return 3
 
 
 def main(argv=None):

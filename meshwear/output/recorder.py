@@ -6,6 +6,7 @@ Physics never writes files; :func:`meshwear.simulate.run` calls
 
 from pathlib import Path
 
+from ..scene import RESERVED_NAMES
 from ..wear import error_estimate
 from .fields import body_quantities, body_totals, part_quantities
 from .export import SERIES_SUFFIXES
@@ -66,10 +67,7 @@ class RunRecorder:
     def _open(self, model, resume_until, state):
         names = [part.name for part in list(model.bodies) + list(model.surfaces.slots)]
         check_writable(self.out_dir, [f"{n}{suffix}" for n in names for suffix in SERIES_SUFFIXES]
-                       + ["history.csv", "summary.json", "checkpoint.npz"], names)
-        if state is not None:   # a run killed from now on is not mistaken for a finished one
-            write_json_atomic(self.out_dir / "summary.json",
-                              summary(model, state, 0.0, "running", "the run has not ended"))
+                       + list(RESERVED_NAMES), names)
         Series = series_class(model)
         self.series = {b.name: Series(self.out_dir, b.name, b.faces, resume_until)
                        for b in model.bodies}
@@ -91,6 +89,11 @@ class RunRecorder:
                 self.moving[surface.name] = (surface, vertices,
                                              Series(self.out_dir, surface.name, faces,
                                                        resume_until))
+        # the files are this run's now (a refused --resume leaves the stopped
+        # run's summary); one killed from here on is not taken for a finished one
+        if state is not None:
+            write_json_atomic(self.out_dir / "summary.json",
+                              summary(model, state, 0.0, "running", "the run has not ended"))
 
     def on_sample(self, model, state):
         for row in history_rows(model, state):
