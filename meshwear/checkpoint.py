@@ -28,23 +28,50 @@ _BODY_ARRAYS = ("pose", "vertices", "wear_depth", "friction_work", "wear_volume"
 _PART_ARRAYS = ("vertices", "frames", "depth", "volume", "work")
 
 
-def scene_digest(scene):
-    """SHA-256 of the scene file, the keys set over it (``--set``) and every
-    mesh file it reads (bodies' and surfaces')."""
-    h = hashlib.sha256()
+def input_digests(scene):
+    """``{what: SHA-256}`` of every input a run reads: the scene file, the
+    keys set over it (``--set``) and each mesh file (bodies' and surfaces'),
+    keyed by what a message names (``body[0].mesh (pin.stl)``)."""
+    out = {f"the scene file {Path(scene.source).name}": _file_digest(Path(scene.source))}
     if getattr(scene, "overrides", ()):
-        h.update(repr(tuple(scene.overrides)).encode())
-    paths = [Path(scene.source)] + [Path(x.mesh) for x in scene.bodies + scene.surfaces
-                                    if getattr(x, "mesh", None) is not None]
-    for path in paths:
-        if path.is_file():
-            h.update(path.read_bytes())
+        out["the keys set over it (--set)"] = hashlib.sha256(
+            repr(tuple(scene.overrides)).encode()).hexdigest()
+    for kind, parts in (("body", scene.bodies), ("surface", scene.surfaces)):
+        for i, part in enumerate(parts):
+            mesh = getattr(part, "mesh", None)
+            if mesh is not None:
+                out[f"{kind}[{i}].mesh ({Path(mesh).name})"] = _file_digest(Path(mesh))
+    return out
+
+
+def _file_digest(path):
+    """SHA-256 of a file's bytes ('' when it cannot be read)."""
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return ""
+
+
+def scene_digest(scene):
+    """One SHA-256 over :func:`input_digests`."""
+    h = hashlib.sha256()
+    for what, digest in sorted(input_digests(scene).items()):
+        h.update(f"{what}={digest};".encode())
     return h.hexdigest()
+
+
+def changed_inputs(saved, scene):
+    """What of :func:`input_digests` differs between a checkpoint's ``saved``
+    (``what=digest`` strings) and ``scene`` now: a list of names."""
+    before = dict(str(item).rsplit("=", 1) for item in saved)
+    now = input_digests(scene)
+    return [what for what in sorted(set(before) | set(now)) if before.get(what) != now.get(what)]
 
 
 def save(path, model, state, wall_time):
     """Write ``state`` to ``path`` atomically (a reader sees the old or the new file)."""
     arrays = {"digest": np.array(scene_digest(model.scene)),
+              "inputs": np.array([f"{k}={v}" for k, v in input_digests(model.scene).items()]),
               "scalars": np.array([state.time, state.step, state.written, wall_time,
                                    float(state.resolved)], dtype=float)}
     for k, s in enumerate(state.bodies):
@@ -111,8 +138,10 @@ def load(path, model, state):
                          f"({type(err).__name__}); run without --resume to start "
                          "again") from None
     if digest != scene_digest(model.scene):
+        changed = changed_inputs(data["inputs"], model.scene) if "inputs" in data else []
+        what = (f": {', '.join(changed)} changed" if changed else " or its meshes")
         raise SceneError(model.scene.source, "", f"{path} was written for another version of this "
-                         "scene or its meshes; run without --resume to start again")
+                         f"scene{what}; run without --resume to start again")
     scalars = data["scalars"]
     if len(scalars) != 5:
         raise SceneError(model.scene.source, "", f"{path} was written by another version of "

@@ -93,7 +93,8 @@ def _jumping(model, resolved):
     bounded the trial's last one, else stay as long; and the remaining outputs
     filled from jumps at the trial's cost per filled output (the writing
     itself is :func:`_writing`'s). Never more than ``resolved``."""
-    from .wear import GROWTH, run_cycle_jump
+    from .simulate import run
+    from .wear import GROWTH
 
     state = initial_state(model)
     start = time.perf_counter()
@@ -104,7 +105,7 @@ def _jumping(model, resolved):
             raise _Budget
 
     try:
-        run_cycle_jump(model, state, progress=progress)
+        run(model, state, progress=progress)
     except _Budget:
         pass
     elapsed = time.perf_counter() - start

@@ -13,10 +13,13 @@ in load balance first). Runs take their steps in the compiled loop
 
 import numpy as np
 
+from functools import partial
+
 from . import stepper, surfaces
 from .geometry import inverted_faces
 from .model import body_contact, wear_counters
 from .output.memory import MemoryHistory
+from .wear import run_cycle_jump
 
 
 #: steps between two progress reports at most
@@ -109,7 +112,8 @@ def no_balance(body, t):
     return NumericalError(f"body {body.name!r}: no contact carries its load at t = {t:.6g} s")
 
 
-def run(model, state, observers=(), progress=None, checkpoint=None, compiled=True):
+def run(model, state, observers=(), progress=None, checkpoint=None, compiled=True,
+        forced_jump=None):
     """Run ``state`` from its current step to the end of ``model``'s duration.
 
     Parameters
@@ -130,6 +134,9 @@ def run(model, state, observers=(), progress=None, checkpoint=None, compiled=Tru
     compiled : bool
         Step with the compiled loop (default), or with the Python reference
         :func:`step` (the same numbers, slower; for tests).
+    forced_jump : int, optional
+        With cycle jumping, jump this many cycles each time instead of the
+        controller's choice (:func:`meshwear.wear.run_cycle_jump`).
 
     Raises
     ------
@@ -138,9 +145,10 @@ def run(model, state, observers=(), progress=None, checkpoint=None, compiled=Tru
         observers have seen every sample before it.
     """
     if model.cycle_steps:
-        from .wear import run_cycle_jump
-
-        return run_cycle_jump(model, state, observers, progress, checkpoint, compiled=compiled)
+        # the jumps resolve their cycles with this module's loop
+        resolve = partial(advance, compiled=compiled)
+        return run_cycle_jump(model, state, resolve, check, observers, progress, checkpoint,
+                              forced_jump)
     advance(model, state, model.n_steps, observers, progress, checkpoint, compiled)
     return state
 

@@ -135,10 +135,14 @@ def choose_jump(rate, previous, gap, penetration_, tolerance, last_jump, limit, 
     return max(0, int(np.floor(bounds[which]))), which
 
 
-def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, forced_jump=None,
-                   compiled=True):
+def run_cycle_jump(model, state, advance, check, observers=(), progress=None, checkpoint=None,
+                   forced_jump=None):
     """Run ``state`` to the end of ``model``'s duration, jumping over cycles.
 
+    The step loop is the caller's (:func:`meshwear.simulate.run` passes its
+    own): ``advance(model, state, stop, observers, progress)`` resolves
+    steps up to ``stop`` writing the outputs due, and
+    ``check(model, state, face_normals)`` refuses an invalid state.
     ``forced_jump`` replaces the controller by a fixed jump (still stopping
     at the end): the fixed-factor scheme of finite-element wear codes, for
     comparisons and tests.
@@ -176,7 +180,7 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
         could = 0 if js.settling or forced_jump == 0 else min(
             end_limit, forced_jump if forced_jump is not None else int(GROWTH * js.last_jump + 1))
         snapshots = filled.record(model, state, start, stop, could, observers, progress,
-                                  compiled)
+                                  advance)
         js.resolved_steps += stop - start
         if stop - start < n_c or state.step >= model.n_steps:
             break
@@ -226,7 +230,7 @@ def run_cycle_jump(model, state, observers=(), progress=None, checkpoint=None, f
             part_spans = _jump_parts(model, parts, before_parts, part_rates, js, jump)
             before_fill = time.perf_counter()
             js.filled_outputs += filled.write(model, state, stop, jump, snapshots, spans,
-                                              observers, part_spans)
+                                              observers, check, part_spans)
             js.fill_seconds += time.perf_counter() - before_fill
             js.jumps += 1
             js.settling = not model.quasi_static

@@ -260,7 +260,6 @@ def test_a_checkpoint_inside_a_jumped_run_resumes_it(tmp_path):
     """A jumped run saved after a jump and resumed ends where the whole run
     does: the counter-part's wear and the jump controller's memory of it
     are in the checkpoint."""
-    from meshwear.wear import run_cycle_jump
     model = build_model(load_scene(_jumped(tmp_path, 6)))
     saved = []
 
@@ -269,12 +268,12 @@ def test_a_checkpoint_inside_a_jumped_run_resumes_it(tmp_path):
             checkpoint.save(tmp_path / "c.npz", model, state, 0.0)
             saved.append(state.step)
 
-    full = run_cycle_jump(model, initial_state(model), checkpoint=save)
+    full = run(model, initial_state(model), checkpoint=save)
     assert saved and full.jump.jumps >= 2
     resumed = initial_state(model)
     checkpoint.load(tmp_path / "c.npz", model, resumed)
     assert resumed.step == saved[0] and resumed.jump.part_rate[0] is not None
-    run_cycle_jump(model, resumed)
+    run(model, resumed)
     for got, want in ((resumed.parts[0].depth, full.parts[0].depth),
                       (resumed.bodies[0].wear_depth, full.bodies[0].wear_depth)):
         assert np.abs(got - want).max() <= 1e-9 * want.max()

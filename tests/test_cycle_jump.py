@@ -10,7 +10,7 @@ import cases
 from meshwear.model import build_model, initial_state
 from meshwear.scene import load_scene
 from meshwear.simulate import run, run_scene
-from meshwear.wear import GROWTH, THETA, choose_jump, error_estimate, run_cycle_jump
+from meshwear.wear import GROWTH, THETA, choose_jump, error_estimate
 
 
 # ---------------------------------------------------------------- controller
@@ -85,7 +85,7 @@ def punch():
             model = build_model(dataclasses.replace(scene, wear=dataclasses.replace(
                 scene.wear, jump=method)))
             state = initial_state(model)
-            run_cycle_jump(model, state, forced_jump=forced)
+            run(model, state, forced_jump=forced)
             out[f"{label} {duration:g}"] = (model, state)
     return out
 
@@ -292,7 +292,7 @@ def test_a_track_touched_once_a_turn_jumps_as_resolved(tmp_path, measured):
     runs = {}
     for name, forced in (("resolved", 0), ("jumped", None)):
         model = build_model(load_scene(path))
-        runs[name] = run_cycle_jump(model, initial_state(model), forced_jump=forced)
+        runs[name] = run(model, initial_state(model), forced_jump=forced)
     w_ref = runs["resolved"].bodies[0].wear_depth
     w = runs["jumped"].bodies[0].wear_depth
     assert runs["resolved"].jump.resolved_steps == model.n_steps

@@ -189,3 +189,24 @@ def test_resume_refuses_a_checkpoint_of_another_scene(tmp_path, capsys):
     code = main(["run", str(scene), "-o", str(out), "--resume", "-q"])
     err = capsys.readouterr().err
     assert code == 2 and "another version of this scene" in err
+    assert "the scene file block.toml changed" in err and ".mesh (" not in err
+
+
+def test_resume_names_the_mesh_file_that_changed(tmp_path, capsys):
+    mesh = tmp_path / "block.stl"
+    mesh.write_bytes((ROOT / "meshes" / "block_10x10x5mm.stl").read_bytes())
+    scene = _block_scene(tmp_path, duration=0.05)
+    scene.write_text(scene.read_text().replace(f"{(ROOT / 'meshes').as_posix()}/block_10x10x5mm.stl",
+                                               mesh.as_posix()))
+    out = tmp_path / "out"
+    out.mkdir()
+    model = build_model(load_scene(scene))
+    checkpoint.save(out / checkpoint.FILE_NAME, model, initial_state(model), 0.0)
+    # the same mesh, one byte of its header changed
+    data = bytearray(mesh.read_bytes())
+    data[0] = (data[0] + 1) % 128
+    mesh.write_bytes(bytes(data))
+    code = main(["run", str(scene), "-o", str(out), "--resume", "-q"])
+    err = capsys.readouterr().err
+    assert code == 2 and "body[0].mesh (block.stl) changed" in err
+    assert "scene file" not in err and len(err.strip().splitlines()) == 1

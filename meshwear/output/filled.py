@@ -60,28 +60,28 @@ def phases(model, start, stop, cycles):
     return out
 
 
-def record(model, state, start, stop, cycles, observers, progress, compiled):
-    """Resolve the cycle ``start..stop`` (writing its own outputs), keeping
-    the snapshots a jump of up to ``cycles`` cycles after it needs."""
-    from ..simulate import advance
-
+def record(model, state, start, stop, cycles, observers, progress, advance):
+    """Resolve the cycle ``start..stop`` (writing its own outputs) by
+    ``advance(model, state, stop, observers, progress)``
+    (:func:`meshwear.simulate.advance`), keeping the snapshots a jump of up
+    to ``cycles`` cycles after it needs."""
     wanted = phases(model, start, stop, cycles)
     snapshots = {}
     for r in sorted(wanted) + [stop]:
-        advance(model, state, r, observers, progress, compiled=compiled)
+        advance(model, state, r, observers, progress)
         if r in wanted:
             snapshots[r - start] = _capture(state, wanted[r])
     return snapshots
 
 
-def write(model, state, stop, jump, snapshots, spans, observers, part_spans=()):
+def write(model, state, stop, jump, snapshots, spans, observers, check, part_spans=()):
     """Write every output strictly inside the span the jump just covered
     (``stop`` to ``stop + jump`` cycles), filled from it (``spans``: per body,
     the jumped arrays at its start and end, and the shift of its position;
     ``part_spans`` the same per worn counter-part, in the order of
-    ``state.parts``). Returns the number of outputs written."""
-    from ..simulate import check
-
+    ``state.parts``); ``check(model, state, face_normals)`` refuses an
+    invalid state (:func:`meshwear.simulate.check`). Returns the number of
+    outputs written."""
     n_c = model.cycle_steps
     end = stop + jump * n_c
     schedule = model.output_steps
