@@ -59,6 +59,10 @@ class BodyModel:
         Cycle length of the body's path (s).
     radius : float
         Largest distance of a vertex from the centre of mass (m).
+    depth_limit : float
+        A body moved by its dynamics (free, guided) stops the run when a
+        vertex in contact is deeper than this (m): :data:`IMPACT_DEPTH` of
+        its thinnest extent; 0 for bodies placed by their path.
     """
 
     name: str
@@ -75,6 +79,7 @@ class BodyModel:
     motion: object
     period: float | None
     radius: float = 0.0
+    depth_limit: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -457,7 +462,19 @@ def _build_body(scene, index, body, surface_set):
         wear_direction=wear_direction,
         reference_face_normals=geometry.face_normals(body_vertices, faces),
         mass=float(mass), inertia=inertia, origin=-com, initial_pose=pose, motion=motion,
-        period=path.period, radius=float(np.linalg.norm(body_vertices, axis=1).max()))
+        period=path.period, radius=float(np.linalg.norm(body_vertices, axis=1).max()),
+        depth_limit=(IMPACT_DEPTH * _thinnest(body_vertices)
+                     if motion.dynamic_axes is not None else 0.0))
+
+
+#: a vertex in contact deeper than this fraction of its body's thinnest
+#: extent means an impact the contact could not stop (docs/model.md, "Impacts")
+IMPACT_DEPTH = 0.25
+
+
+def _thinnest(vertices):
+    """The smallest extent of a body's bounding box (m)."""
+    return float(np.ptp(vertices, axis=0).min())
 
 
 #: a face of a body that is not free can come into contact where it faces a
@@ -487,7 +504,7 @@ def _refuse_deep_start(scene, index, body, config, surface_set, vertex_planes):
     """A body placed deep inside a surface would be shot out by its first steps."""
     R = np.array(rotation_entries(body.initial_pose[3:7])).reshape(3, 3)
     x = body.initial_pose[0:3] + body.reference_vertices @ R.T
-    allowed = START_PENETRATION * float(np.ptp(body.reference_vertices, axis=0).min())
+    allowed = START_PENETRATION * _thinnest(body.reference_vertices)
     depths = [(p, -float(((x - row[0]) @ row[1]).min()))
               for p, row in zip(surface_set.uniform, surface_set.planes)]
     # vertices with no plane under them (zero normal) are not inside
@@ -606,13 +623,26 @@ def _stable_limit(bodies, law, slots):
 
 
 def check_time_step(model):
-    """Refuse a ``run.dt`` above :func:`stable_time_step`; return the limit.
+    """Refuse a ``run.dt`` above :func:`stable_time_step`, or one in which a
+    dynamic body's starting speed carries it deeper than its ``depth_limit``;
+    return the limit.
 
     Raises
     ------
     SceneError
-        Naming ``run.dt`` and the largest stable dt.
+        Naming ``run.dt`` and the largest stable dt, or ``body[i].velocity``.
     """
+    for index, b in enumerate(model.bodies):
+        # a step must not carry a body deeper than its contact can stand for
+        # before the contact has even seen it (docs/model.md, "Impacts")
+        speed = (float(np.linalg.norm(b.initial_pose[7:10]))
+                 + float(np.linalg.norm(b.initial_pose[10:13])) * b.radius)
+        if b.depth_limit > 0.0 and speed * model.dt > b.depth_limit:
+            raise SceneError(model.scene.source, f"body[{index}].velocity",
+                             f"body {b.name!r} moves {speed * model.dt:.3g} m in one step of "
+                             f"{model.dt:.3g} s, more than {IMPACT_DEPTH:.0%} of its thinnest "
+                             f"extent ({b.depth_limit / IMPACT_DEPTH:.3g} m): no contact can "
+                             "stop it within the body; lower the speed or run.dt")
     limit, who = stable_time_step(model)
     if model.dt > limit:
         asked = model.scene.run.dt

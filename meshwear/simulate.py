@@ -17,7 +17,8 @@ from functools import partial
 
 from . import stepper, surfaces
 from .geometry import inverted_faces
-from .model import body_contact, wear_counters
+from .kernels.loop import deepest_penetration
+from .model import IMPACT_DEPTH, body_contact, wear_counters
 from .output.memory import MemoryHistory
 from .wear import run_cycle_jump
 
@@ -48,6 +49,11 @@ def step_body(model, body, s, k):
     t = k * model.dt
     surfaces.update(model, body, s, t)
     touch(model, body, s, t)
+    if body.depth_limit > 0.0:
+        depth, slot, vertex = deepest_penetration(s.vertices, s.pose, model.planes,
+                                                  s.vertex_planes, s.active, s.contact_state)
+        if depth > body.depth_limit:
+            raise impact_too_deep(model, body, s, slot, vertex, t)
     body.motion.advance(s.pose, s.wrench, t, model.dt)
 
 
@@ -105,6 +111,21 @@ def counter_too_deep(model, surface, vertex, t):
         f"surface {surface.name!r}: vertex {vertex} wore {surface.part.depth[vertex]:.3g} m deep, "
         f"more than half its shortest edge ({surface.spacing[vertex]:.3g} m) in the step to "
         f"t = {t:.6g} s: refine the surface (resolution), lower its wear coefficient or "
+        "shorten run.dt")
+
+
+def impact_too_deep(model, body, s, slot, vertex, t):
+    """The error of a body vertex that went deeper into a surface than its
+    contact can stand for (docs/model.md, "Impacts")."""
+    depth = deepest_penetration(s.vertices, s.pose, model.planes, s.vertex_planes,
+                                np.array([vertex]), s.contact_state)[0]
+    surface = model.surfaces.slots[slot]
+    speed = float(np.linalg.norm(s.pose[7:10]))
+    return NumericalError(
+        f"body {body.name!r}: vertex {vertex} went {depth:.3g} m into surface {surface.name!r} "
+        f"at t = {t:.6g} s, more than {IMPACT_DEPTH:.0%} of the body's thinnest extent "
+        f"({body.depth_limit / IMPACT_DEPTH:.3g} m): an impact faster than the contact can stop "
+        f"(body speed {speed:.3g} m/s); lower the speed, raise the contact stiffness or "
         "shorten run.dt")
 
 

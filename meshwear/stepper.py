@@ -19,7 +19,7 @@ def _body_arrays(model, body, s):
     return (s.vertices, s.pose, body.area_vectors, model.law, body.wear_direction,
             s.contact_state, s.tangential, s.normal_force, s.friction_work, s.wear_depth,
             s.wear_volume, s.wrench, s.vertex_planes, s.hint, s.active, s.active_wear, s.cull,
-            s.cull_scratch.distance, s.load, float(body.radius))
+            s.cull_scratch.distance, s.load, float(body.radius), float(body.depth_limit))
 
 
 def _motion_arrays(model, body, s):
@@ -45,7 +45,7 @@ def advance(model, state, until):
 
 
 def _advance_bodies(model, state, start, until):
-    from .simulate import counter_too_deep, finish_step, no_balance, step_body
+    from .simulate import counter_too_deep, finish_step, impact_too_deep, no_balance, step_body
 
     dt = model.dt
     surfaces = model.surfaces
@@ -68,6 +68,8 @@ def _advance_bodies(model, state, start, until):
             elif what == loop.TOO_DEEP:
                 t = (k + 1) * dt if model.quasi_static else k * dt
                 raise counter_too_deep(model, surfaces.per_vertex[report[0]], report[1], t)
+            elif what == loop.IMPACT:
+                raise impact_too_deep(model, body, s, report[0], report[1], k * dt)
             else:
                 raise no_balance(body, (k + 1) * dt)
             k += 1

@@ -449,3 +449,21 @@ def face_frames(vertices, faces):
         m /= np.linalg.norm(m, axis=1)[:, None]
         out[:, e + 1, 0:3], out[:, e + 1, 3] = m, _dot(m, p)
     return out
+
+
+def deepest_penetration(body_vertices, pose, planes, vertex_planes, active, contact_state):
+    """Twin of :func:`meshwear.kernels.loop.deepest_penetration`."""
+    x = pose[0:3] + body_vertices[active] @ quaternion_matrix(pose[3:7]).T
+    best = (0.0, -1, -1)
+    for s in range(contact_state.shape[0]):
+        if s < len(planes):
+            point, normal = planes[s, 0], planes[s, 1]
+        else:
+            point = vertex_planes[s - len(planes), active, 0]
+            normal = vertex_planes[s - len(planes), active, 1]
+        depth = -np.einsum("ij,ij->i", x - point, np.broadcast_to(normal, x.shape))
+        depth[contact_state[s, active] == 0] = -np.inf
+        k = int(np.argmax(depth))
+        if depth[k] > best[0]:
+            best = (float(depth[k]), s, int(active[k]))
+    return best

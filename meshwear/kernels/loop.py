@@ -34,21 +34,22 @@ surfaces
 bounds, terms
     The active-set bounds of every slot (:mod:`meshwear.kernels.frames`).
 report
-    (2,) int64: where a counter vertex worn too deep is reported (surface, vertex).
+    (2,) int64: where a counter vertex worn too deep (surface, vertex) or a
+    body vertex gone too deep (slot, vertex) is reported.
 """
 
 import numpy as np
 from numba import njit
 
 from .balance import balance_offset
-from .contact import PARALLEL_THRESHOLD, contact_parallel, contact_serial
+from .contact import PARALLEL_THRESHOLD, contact_parallel, contact_serial, rotation_entries
 from .counter import fill_planes
 from .counter_wear import wear_counter
 from .frames import moved_since_refresh, plane_rows, step_motion, surface_frame
 from .rigid import AXIS, BALANCED, CARRIED, advance_motion, place_motion
 
 #: what :func:`advance_body` returns besides the step it reached
-DONE, REFRESH, FINISH, NO_BALANCE, TOO_DEEP = 0, 1, 2, 3, 4
+DONE, REFRESH, FINISH, NO_BALANCE, TOO_DEEP, IMPACT = 0, 1, 2, 3, 4, 5
 
 
 @njit(cache=True)
@@ -72,7 +73,7 @@ def _touch(body, plane_array):
     added to ``load``."""
     (vertices, pose, area, law, wear_direction, contact_state, tangential, normal_force,
      friction_work, wear_depth, wear_volume, wrench, vertex_planes, hint, active, active_wear,
-     cull, distance, load, radius) = body
+     cull, distance, load, radius, depth_limit) = body
     slots = plane_array.shape[0] + vertex_planes.shape[0]
     if active.shape[0] * slots >= PARALLEL_THRESHOLD:
         contact_parallel(vertices, pose, plane_array, vertex_planes, active, area, law,
@@ -90,6 +91,39 @@ def _touch(body, plane_array):
                 total += normal_force[s, i]
             load[0, i] += total
             load[1, i] += total * total
+
+
+@njit(cache=True)
+def deepest_penetration(vertices, pose, plane_array, vertex_planes, active, contact_state):
+    """The deepest penetration (m, positive inside) of the body's vertices in
+    contact (``contact_state`` not 0) at ``pose``, with its slot and vertex
+    (-1, -1 when none is in contact): docs/model.md, "Impacts"."""
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
+    n_planes = plane_array.shape[0]
+    deepest, where_slot, where_vertex = 0.0, -1, -1
+    for k in range(active.shape[0]):
+        i = active[k]
+        for s in range(contact_state.shape[0]):
+            if contact_state[s, i] == 0:
+                continue
+            bx, by, bz = vertices[i, 0], vertices[i, 1], vertices[i, 2]
+            px = pose[0] + r00 * bx + r01 * by + r02 * bz
+            py = pose[1] + r10 * bx + r11 * by + r12 * bz
+            pz = pose[2] + r20 * bx + r21 * by + r22 * bz
+            # the plane under the vertex, read as scalars as the contact kernel does
+            if s < n_planes:
+                ox, oy, oz = plane_array[s, 0, 0], plane_array[s, 0, 1], plane_array[s, 0, 2]
+                nx, ny, nz = plane_array[s, 1, 0], plane_array[s, 1, 1], plane_array[s, 1, 2]
+            else:
+                m = s - n_planes
+                ox, oy = vertex_planes[m, i, 0, 0], vertex_planes[m, i, 0, 1]
+                oz = vertex_planes[m, i, 0, 2]
+                nx, ny = vertex_planes[m, i, 1, 0], vertex_planes[m, i, 1, 1]
+                nz = vertex_planes[m, i, 1, 2]
+            depth = -((px - ox) * nx + (py - oy) * ny + (pz - oz) * nz)
+            if depth > deepest:
+                deepest, where_slot, where_vertex = depth, s, i
+    return deepest, where_slot, where_vertex
 
 
 @njit(cache=True)
@@ -138,11 +172,13 @@ def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, 
     :data:`FINISH` (quasi-static: step ``step`` is placed, its planes queried
     and the body settled, but its bound is reached: refresh, query and touch
     are left), :data:`NO_BALANCE` (no contact carries the load at step
-    ``step``) or :data:`TOO_DEEP` (step ``step`` wore a counter vertex deeper
+    ``step``), :data:`TOO_DEEP` (step ``step`` wore a counter vertex deeper
     than its mesh follows: surface and vertex in ``report``; the step's
-    contact is done, its motion is not)."""
+    contact is done, its motion is not) or :data:`IMPACT` (the dynamic step
+    ``step`` found a vertex in contact deeper than ``depth_limit``: slot and
+    vertex in ``report``; its contact is done, its motion is not)."""
     vertices, pose, area, law = body[0], body[1], body[2], body[3]
-    vertex_planes, active, cull, radius = body[12], body[14], body[16], body[19]
+    vertex_planes, active, cull, radius, depth_limit = body[12], body[14], body[16], body[19], body[20]
     kind, params, path_terms, buffer, scratch = motion
     plane_array = planes[0]
     n_planes = plane_array.shape[0]
@@ -165,6 +201,12 @@ def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, 
             if worn and not _wear_parts(body, surfaces, law, n_planes, t, buffer,
                                         rotation, frame, report):
                 return k, TOO_DEEP
+            if depth_limit > 0.0:
+                depth, slot, vertex = deepest_penetration(vertices, pose, plane_array,
+                                                          vertex_planes, active, body[5])
+                if depth > depth_limit:
+                    report[0], report[1] = slot, vertex
+                    return k, IMPACT
             advance_motion(kind, params, path_terms, buffer, pose, body[11], t, dt)
             k += 1
             continue
