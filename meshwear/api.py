@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .remesh import available_memory
 from .scene import Scene, SceneError, load_scene
 
 
@@ -168,6 +169,7 @@ def run(scene, *, out=None, progress=None, vertex_history=False, check_dt=True):
     model = build_model(scene)
     if check_dt:
         check_time_step(model)
+    _refuse_more_history_than_memory(model, vertex_history)
     state = initial_state(model)
     columns = HistoryColumns(vertex_history)
     observers = [columns]
@@ -224,6 +226,29 @@ def _parts(model, state, columns, table):
 
 #: history columns that count
 INTEGER_COLUMNS = ("contact_points", "stick_points", "slip_points", "resolved")
+
+
+#: memory one history row takes in :class:`HistoryColumns` (B): measured
+#: ~1.5 KiB as a dict of Python floats, and its share of the columns
+ROW_BYTES = 2048
+
+
+def _refuse_more_history_than_memory(model, vertex_history):
+    """SceneError naming ``run.history`` when the rows kept in memory (and
+    each part's wear depth per row, if asked) need more than the available
+    memory."""
+    samples = len(model.sample_steps)
+    sizes = [len(b.tributary_area) for b in model.bodies] + [
+        len(m.vertices) for m in model.surfaces.per_vertex if m.worn]
+    need = samples * len(sizes) * ROW_BYTES + (8 * samples * sum(sizes) if vertex_history else 0)
+    memory = available_memory()
+    if memory is not None and need > memory:
+        kept = "history rows and per-vertex wear depths" if vertex_history else "history rows"
+        raise SceneError(model.scene.source, "run.history",
+                         f"{samples} samples of {len(sizes)} part(s): their {kept} take about "
+                         f"{need / 2**30:.3g} GiB in memory, more than the "
+                         f"{memory / 2**30:.3g} GiB available; ask fewer, or run "
+                         "`meshwear run`, which writes them to history.csv")
 
 
 class HistoryColumns:

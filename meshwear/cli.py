@@ -275,9 +275,14 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=
     except OSError as err:  # the disk filled up, or the folder went away, mid-run
         if progress:
             progress.finish()
-        raise InputError(f"{err.filename or out_dir}: cannot write the outputs "
-                         f"({err.strerror or err}); those written before t = {state.time:.6g} s "
-                         "are kept") from None
+        message = (f"{err.filename or out_dir}: cannot write the outputs "
+                   f"({err.strerror or err}); those written before t = {state.time:.6g} s "
+                   "are kept")
+        try:  # summary.json says so, where it still can be written
+            recorder.close(summary(model, state, saver.wall_time, "write_error", message))
+        except OSError:
+            pass
+        raise InputError(message) from None
     except NumericalError as err:
         if progress:
             progress.finish()

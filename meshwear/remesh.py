@@ -11,8 +11,45 @@ from .geometry import MeshError, _arrays, _doubled_areas, _edge_keys, _edge_leng
 #: area of the largest triangle whose edges are all <= 1 (equilateral)
 _LARGEST_UNIT_TRIANGLE = np.sqrt(3.0) / 4.0
 
+#: faces refined at most, whatever the memory
+MAX_FACES = 5_000_000
+#: memory a face of a refined part takes while the model is built (B):
+#: measured ~650 on a refined pin against a plane (peak RSS of build_model
+#: over 0.2-0.9 M faces), with room for more counter-surfaces
+BYTES_PER_FACE = 1024
 
-def refine(vertices, faces, resolution, face_mask=None, max_faces=5_000_000):
+
+def available_memory():
+    """Bytes of memory the system can give without swapping (None if unknown)."""
+    try:
+        import psutil
+
+        return int(psutil.virtual_memory().available)
+    except Exception:  # noqa: BLE001 - psutil missing or unsupported here
+        pass
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return None
+
+
+def face_limit(memory=None):
+    """``(faces, why)``: the most faces a refinement may make here, the smaller
+    of :data:`MAX_FACES` and what the available memory holds at
+    :data:`BYTES_PER_FACE`, and the reason a refusal gives."""
+    memory = available_memory() if memory is None else memory
+    if memory is not None and memory // BYTES_PER_FACE < MAX_FACES:
+        return int(memory // BYTES_PER_FACE), (f"what this machine's {memory / 2**30:.3g} GiB of "
+                                               f"available memory holds at about "
+                                               f"{BYTES_PER_FACE} B a face")
+    return MAX_FACES, "the largest refinement meshwear makes"
+
+
+def refine(vertices, faces, resolution, face_mask=None, max_faces=None):
     """Split triangles until every edge of the selected faces is <= ``resolution``.
 
     Conforming longest-edge bisection (Rivara): a face that needs refining has
@@ -36,11 +73,12 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=5_000_000):
     face_mask : (m,) bool, optional
         Faces to refine (default all). Children of selected faces stay selected;
         unselected faces are split only where needed to stay conforming.
-    max_faces : int
+    max_faces : int, optional
         Refuse (MeshError) rather than build a larger mesh: at once when the
         selected area alone needs more faces (a triangle with edges <=
         ``resolution`` covers sqrt(3)/4 resolution² at most), else as soon as
-        a pass makes more.
+        a pass makes more. Default: :func:`face_limit` (this machine's
+        available memory, at most :data:`MAX_FACES`).
 
     Returns
     -------
@@ -56,9 +94,12 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=5_000_000):
     area = 0.5 * float(_doubled_areas(V, F[mask]).sum())
     cell = _LARGEST_UNIT_TRIANGLE * resolution**2     # 0.0 for a subnormal resolution
     least = area / cell if cell > 0.0 else float("inf")
+    why = "the limit asked"
+    if max_faces is None:
+        max_faces, why = face_limit()
     if not least <= max_faces:
         raise MeshError(f"refining to resolution {resolution:g} m needs at least {least:.3g} "
-                        f"faces, more than {max_faces}; give a coarser resolution")
+                        f"faces, more than {max_faces} ({why}); give a coarser resolution")
     while True:
         lengths = _edge_lengths(V, F)
         need = mask & (lengths.max(axis=1) > resolution)
@@ -88,7 +129,8 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=5_000_000):
         active[first_new:] = True
         F = _flip_coplanar(V, F, mask, active)
         if len(F) > max_faces:
-            raise MeshError(f"refining to resolution {resolution:g} m needs more than {max_faces} faces")
+            raise MeshError(f"refining to resolution {resolution:g} m needs more than {max_faces} "
+                            f"faces ({why}); give a coarser resolution")
 
 
 def _bisect(F, mask, eid, midpoint, marked, longest):

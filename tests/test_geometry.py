@@ -272,7 +272,7 @@ def test_refine_leaves_fine_meshes_alone_and_checks_inputs():
     with pytest.raises(ValueError, match="face_mask"):
         remesh.refine(vertices, faces, 0.1, face_mask=np.ones(3, bool))
     # refused before any work: 11.7 m² in triangles of at most 0.433 mm² is 2.7e7 faces
-    with pytest.raises(MeshError, match=r"at least 2.69e\+07 faces, more than 1000;"):
+    with pytest.raises(MeshError, match=r"at least 2.69e\+07 faces, more than 1000 \(the limit asked\);"):
         remesh.refine(vertices, faces, 1e-3, max_faces=1000)
     # and, past that lower bound (299 faces), when a pass makes more
     with pytest.raises(MeshError, match="needs more than 400 faces"):

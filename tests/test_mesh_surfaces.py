@@ -552,10 +552,20 @@ def test_turning_disc_cycle_jump_resumes_to_the_same_wear_and_writes_its_series(
     del dataclasses
 
 
-def test_the_active_set_changes_no_result(tmp_path):
+#: the tossed cube's plate as a mesh counter-surface (a 150 mm box, top at z = 0)
+MESH_PLATE = """[[surface]]
+name = "plate"
+type = "mesh"
+shape = { type = "box", size = [0.15, 0.15, 0.01] }
+position = [0.0, 0.0, -0.005]
+"""
+
+
+@pytest.mark.parametrize("plate", ["plane", "mesh"])
+def test_the_active_set_changes_no_result(tmp_path, plate):
     """The tossed cube (free, tumbling, corners and edges landing) with and
-    without the active set: the same numbers, while most steps process few
-    vertices."""
+    without the active set, on an analytic plane and on a mesh plate: the
+    same numbers, while most steps process few vertices."""
     import dataclasses
 
     from meshwear.model import build_model, initial_state
@@ -563,10 +573,17 @@ def test_the_active_set_changes_no_result(tmp_path):
     from meshwear.simulate import run
 
     root = __import__("pathlib").Path(__file__).resolve().parents[1]
-    scene = load_scene(root / "examples" / "cube_toss.toml")
+    source = root / "examples" / "cube_toss.toml"
+    if plate == "mesh":
+        text = source.read_text().replace('"../meshes/', f'"{(root / "meshes").as_posix()}/')
+        text = text[:text.index("[[surface]]")] + MESH_PLATE
+        source = tmp_path / "cube_on_a_mesh_plate.toml"
+        source.write_text(text)
+    scene = load_scene(source)
     scene = dataclasses.replace(scene, run=dataclasses.replace(scene.run, duration=0.15,
                                                                frames=0, history=16))
     model = build_model(scene)
+    assert (len(model.surfaces.per_vertex) == 1) == (plate == "mesh")
     results = {}
     for cull in (True, False):
         m = dataclasses.replace(model, cull=cull)
@@ -574,6 +591,7 @@ def test_the_active_set_changes_no_result(tmp_path):
         state = run(m, initial_state(m), observers=[history])
         results[cull] = (state.bodies[0], history.rows["cube"])
     (on, rows_on), (off, rows_off) = results[True], results[False]
+    assert on.wear_depth.max() > 0.0 and rows_on["contact_points"].max() > 0
     for name in ("pose", "wear_depth", "friction_work", "normal_force"):
         np.testing.assert_allclose(getattr(on, name), getattr(off, name), rtol=1e-9, atol=1e-15)
     n = len(on.wear_depth)

@@ -4,13 +4,15 @@ Physics never writes files; :func:`meshwear.simulate.run` calls
 ``on_sample`` / ``on_frame`` and the CLI calls ``close`` with the summary.
 """
 
+import errno
+import shutil
 from pathlib import Path
 
 from ..scene import RESERVED_NAMES
 from ..wear import error_estimate
 from .fields import body_quantities, body_totals, part_quantities
 from .export import SERIES_SUFFIXES
-from .folder import FolderLock, check_writable
+from .folder import SPARE_BYTES, FolderLock, check_writable
 from .tables import HISTORY_COLUMNS, HistoryWriter, write_json_atomic
 from .vtk import PVDSeries
 
@@ -28,6 +30,8 @@ def series_class(model):
 EXTRA_COLUMNS = ("wx", "wy", "wz", "tx", "ty", "tz", "contact_points", "stick_points", "slip_points",
                  "resolved")
 FIELDS = ("wear_depth", "normal_force", "friction_force", "pressure", "contact_state", "friction_work")
+#: a history.csv row at most (B): 28 columns of up to 17 characters
+ROW_BYTES = 28 * 18
 
 
 class RunRecorder:
@@ -94,6 +98,7 @@ class RunRecorder:
         if state is not None:
             write_json_atomic(self.out_dir / "summary.json",
                               summary(model, state, 0.0, "running", "the run has not ended"))
+        self._projected = False
 
     def on_sample(self, model, state):
         for row in history_rows(model, state):
@@ -113,6 +118,27 @@ class RunRecorder:
             series.write_frame(state.time, q["points"], {k: q[k] for k in FIELDS},
                                {"resolved": int(state.resolved), "origin": q["origin"],
                                 "orientation": q["orientation"]})
+        if not self._projected:
+            self._projected = True
+            self._refuse_a_full_disk(model, state)
+
+    def _refuse_a_full_disk(self, model, state):
+        """After the run's first frame, whose size is now known: refuse
+        (``OSError(ENOSPC)``) a run whose frames and history rows to come
+        need more than the folder's free space, before any more work."""
+        series = (list(self.series.values()) + list(self.parts.values())
+                  + [s for _, _, s in self.moving.values()])
+        per_frame = sum(getattr(s, "frame_bytes", 0) for s in series)
+        frames = int((model.frame_steps > state.step).sum())
+        rows = int((model.sample_steps > state.step).sum()) * len(history_rows(model, state))
+        need = per_frame * frames + ROW_BYTES * rows
+        free = shutil.disk_usage(self.out_dir).free
+        if need + SPARE_BYTES > free:
+            raise OSError(errno.ENOSPC,
+                          f"No space left on device for this run: its {frames} frames to come "
+                          f"({per_frame / 2**20:.3g} MiB each) and {rows} history rows need "
+                          f"about {need / 2**30:.3g} GiB, {free / 2**30:.3g} GiB are free "
+                          "(fewer run.frames, or another folder)", str(self.out_dir))
 
     def finish(self):
         """Close the history and every series, and free the folder."""

@@ -124,6 +124,8 @@ class PVDSeries:
         ensure_space(self.frame_dir, self._last_size or mesh.actual_memory_size * 1024)
         mesh.save(path, binary=True, compression="zlib")
         self._last_size = path.stat().st_size
+        #: what the last frame added to the series (B)
+        self.frame_bytes = self._last_size
         self._entries.append((float(time), relative))
         self._write_pvd()
         return path

@@ -135,6 +135,7 @@ class VTKHDFSeries:
         points, data = frame_arrays(points, self.faces, point_data)
         n = len(points)
         ensure_space(self.out_dir, points.nbytes + sum(v.nbytes for v in data.values()))
+        size_before = self.path.stat().st_size
         root, steps = self._file["VTKHDF"], self._file["VTKHDF/Steps"]
         step = int(steps.attrs["NSteps"])
         fields = {"TimeValue": np.array([float(time)])}
@@ -172,6 +173,8 @@ class VTKHDFSeries:
         self._append(steps["ConnectivityIdOffsets"], [[0, 0, 0, 0]])
         steps.attrs["NSteps"] = np.int64(step + 1)                    # the frame counts from here
         self._file.flush()
+        #: what the last frame added to the file (B)
+        self.frame_bytes = max(0, self.path.stat().st_size - size_before)
         return self.path
 
     def _cut(self, keep):
