@@ -13,6 +13,7 @@ workers' imports.
 """
 
 import argparse
+import json
 import sys
 import tempfile
 import time
@@ -44,8 +45,11 @@ def main(argv=None):
              f"on a LocalCluster of {_workers()} processes (`meshwear sweep`) | ratio | "
              "a run alone / side by side | ceiling | overhead |",
              "|---|---|---|---|---|---|---|"]
+    figures = []
     for duration in args.duration:
-        table.append(_compare(args.runs, duration))
+        row, numbers = _compare(args.runs, duration)
+        table.append(row)
+        figures.append(numbers)
         print(table[-1], flush=True)
     notes = [
         "",
@@ -60,6 +64,8 @@ def main(argv=None):
 
         replace_section(ROOT / "docs" / "sweeps.md", "<!-- speedup -->", "<!-- /speedup -->",
                         "<!-- speedup -->\n" + "\n".join(table + notes) + "\n<!-- /speedup -->")
+    print(json.dumps({"benchmark": "sweep_speedup", "workers": _workers(), "runs": args.runs,
+                      "sweeps": figures}))
     return 0
 
 
@@ -83,10 +89,15 @@ def _compare(runs, duration):
     alone = loop / runs
     together = sum(r["wall_time"] for r in rows) / runs
     workers = _workers()
+    numbers = {"duration_s": duration, "loop_s": loop, "cluster_s": cluster,
+               "ratio": loop / cluster, "ceiling": workers * alone / together,
+               "overhead_s": cluster - runs * together / workers,
+               "loop_vertex_steps_per_s": points / loop,
+               "cluster_vertex_steps_per_s": points / cluster}
     return (f"| {runs} × {duration:g} s | {loop:.1f} s ({points / loop:.3g}) | "
             f"{cluster:.1f} s ({points / cluster:.3g}) | **{loop / cluster:.2f}×** | "
-            f"{alone:.2f} s / {together:.2f} s | {workers * alone / together:.2f}× | "
-            f"{cluster - runs * together / workers:.1f} s |")
+            f"{alone:.2f} s / {together:.2f} s | {numbers['ceiling']:.2f}× | "
+            f"{numbers['overhead_s']:.1f} s |"), numbers
 
 
 def _workers():

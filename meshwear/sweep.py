@@ -214,10 +214,20 @@ class _client:
         if self.scheduler is not None:
             self.client = Client(self.scheduler)
             return self.client, None
+        import multiprocessing
+
+        import dask
+
         n = self.workers or os.cpu_count() or 1
-        self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                    dashboard_address=None, silence_logs=logging.ERROR,
-                                    env={"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"})
+        # forked workers start with what this process has loaded (numba's
+        # kernels once a run has taken place here: a script's or a
+        # notebook's second sweep) instead of importing it all again
+        # (docs/sweeps.md); numba's workqueue threads are fork-safe
+        method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+        with dask.config.set({"distributed.worker.multiprocessing-method": method}):
+            self.cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                        dashboard_address=None, silence_logs=logging.ERROR,
+                                        env={"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"})
         self.client = Client(self.cluster)
         return self.client, 1
 
