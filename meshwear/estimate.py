@@ -10,13 +10,17 @@ import tempfile
 import time
 from dataclasses import dataclass
 
+import numpy as np
+
 from . import stepper
 from .model import initial_state
 
 #: steps timed for the per-step cost
 TRIAL_STEPS = 200
-#: wall time (s) a cycle-jumping run is tried for
-JUMP_TRIAL = 3.0
+#: wall time (s) a cycle-jumping run is tried for, and longer, up to
+#: JUMP_TRIAL_LONGEST, until bounds other than growth have set BOUNDED_JUMPS
+#: jumps (what the rest of the run's jumps are extrapolated from)
+JUMP_TRIAL, JUMP_TRIAL_LONGEST, BOUNDED_JUMPS = 3.0, 10.0, 8
 
 
 @dataclass
@@ -49,7 +53,9 @@ def estimate_run(model):
     written but temporary files)."""
     state = initial_state(model)
     warm = 1 if model.n_steps > 1 else 0
-    stepper.advance(model, state, warm)  # compile (or load the cached) kernels
+    start = time.perf_counter()
+    stepper.advance(model, state, warm)  # compile (or load the cached) kernels, as the run does
+    load = time.perf_counter() - start
     trial = min(model.n_steps - warm, TRIAL_STEPS)
     start = time.perf_counter()
     stepper.advance(model, state, warm + trial)
@@ -57,24 +63,27 @@ def estimate_run(model):
     active = sum(len(s.active) for s in state.bodies)
     vertices = sum(len(b.tributary_area) for b in model.bodies)
     writing = _writing(model, state)
-    e = Estimate(stepping=per_step * model.n_steps, writing=writing, per_step=per_step,
-                 points=active * max(1, model.slots), active=active, vertices=vertices)
+    e = Estimate(stepping=load + per_step * (model.n_steps - warm), writing=writing,
+                 per_step=per_step, points=active * max(1, model.slots), active=active,
+                 vertices=vertices)
     if model.cycle_steps:
         e.stepping, e.trial_time, e.trial_covered = _jumping(model, e.stepping)
+        e.stepping += load
     return e
 
 
 def _writing(model, state):
     """Seconds to set up the outputs and write every frame and history row
-    of ``model`` (one of each timed, after one to warm up)."""
+    of ``model``: the first of each timed (the writers' imports and set-up,
+    which the run pays too), then one of each again."""
     from .output.recorder import RunRecorder
 
     with tempfile.TemporaryDirectory() as out:
         start = time.perf_counter()
         recorder = RunRecorder(out, model)
-        setup = time.perf_counter() - start
         recorder.on_frame(model, state)
         recorder.on_sample(model, state)
+        first = time.perf_counter() - start
         start = time.perf_counter()
         recorder.on_frame(model, state)
         frame = time.perf_counter() - start
@@ -82,15 +91,35 @@ def _writing(model, state):
         recorder.on_sample(model, state)
         sample = time.perf_counter() - start
         recorder.finish()
-    return setup + frame * len(model.frame_steps) + sample * len(model.sample_steps)
+    return (first + frame * max(0, len(model.frame_steps) - 1)
+            + sample * max(0, len(model.sample_steps) - 1))
+
+
+def _bound_trend(taken):
+    """``(a, b)``: the jumps a bound other than growth set in the trial, as
+    ``J = a p^b`` at cycle ``p``. The error such bounds allow is a fraction
+    of the depth worn so far, which grows with the cycles run, so their
+    jumps grow in proportion (b = 1, ``a`` the median of J / p) unless the
+    trial's own jumps span a decade of cycles: then b is fitted (least
+    squares of log J on log p, within 0..1). None if no such bound held a
+    jump."""
+    bounded = [(p, j) for p, j, which in taken if which not in ("growth", "end")]
+    if not bounded:
+        return None
+    p, j = np.log(np.array(bounded, dtype=float).T)
+    b = 1.0
+    if np.ptp(p) >= np.log(10.0):
+        b = float(np.clip(np.polyfit(p, j, 1)[0], 0.0, 1.0))
+    return float(np.exp(np.median(j - b * p))), b
 
 
 def _jumping(model, resolved):
     """``(seconds, trial seconds, steps covered by the trial)`` of a
     cycle-jumping run: the run itself tried for :data:`JUMP_TRIAL` s (or to
-    its end), the rest simulated at the trial's cost per resolved cycle with
-    the controller's rule: jumps go on growing (``GROWTH J + 1``) if growth
-    bounded the trial's last one, else stay as long; and the remaining outputs
+    its end; longer while it has seen fewer than :data:`BOUNDED_JUMPS` jumps
+    set by a bound other than growth), the rest simulated at the trial's cost per resolved cycle with
+    the controller's rule: jumps go on growing (``GROWTH J + 1``) up to the
+    trend of the other bounds in the trial (:func:`_bound_trend`); and the remaining outputs
     filled from jumps at the trial's cost per filled output (the writing
     itself is :func:`_writing`'s). Never more than ``resolved``."""
     from .simulate import run
@@ -101,7 +130,10 @@ def _jumping(model, resolved):
     budget = min(JUMP_TRIAL, resolved)
 
     def progress(step, n_steps):
-        if time.perf_counter() - start > budget:
+        elapsed = time.perf_counter() - start
+        js = state.jump
+        bounded = 0 if js is None else sum(w not in ("growth", "end") for _, _, w in js.taken)
+        if elapsed > budget and (bounded >= BOUNDED_JUMPS or elapsed > JUMP_TRIAL_LONGEST):
             raise _Budget
 
     try:
@@ -120,13 +152,16 @@ def _jumping(model, resolved):
     # a resolved cycle, its jump's work included
     per_cycle = (elapsed - js.fill_seconds) / max(js.resolved_steps / n_c, 1.0)
     settle = 0 if model.quasi_static else 1      # a dynamic run resolves a cycle after a jump
-    growing = js.last_limit in (None, "growth")
     position, total = state.step / n_c, model.n_steps / n_c
-    jump, seconds = float(js.last_jump), elapsed + per_output * remaining
+    bound = _bound_trend(js.taken)
+    jump = float(js.last_jump)
+    seconds = elapsed + per_output * remaining
     while position < total and seconds < resolved:
         position += 1.0
         seconds += per_cycle
-        jump = GROWTH * jump + 1.0 if growing else max(1.0, jump)
+        jump = GROWTH * jump + 1.0
+        if bound is not None:
+            jump = max(1.0, min(jump, bound[0] * position ** bound[1]))
         if position < total:
             position += jump + settle
             seconds += settle * per_cycle

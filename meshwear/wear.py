@@ -81,6 +81,8 @@ class JumpState:
     last_limit: str | None = None                   # the bound that set the latest jump
     fill_seconds: float = 0.0                       # wall time filling outputs from jumps
     filled_outputs: int = 0                         # outputs filled from jumps
+    taken: list = field(default_factory=list)       # the jumps taken: (cycle it starts at,
+                                                    # cycles, the bound that set it)
 
 
 def penetration(model, body, s):
@@ -233,6 +235,7 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                                               observers, check, part_spans)
             js.fill_seconds += time.perf_counter() - before_fill
             js.jumps += 1
+            js.taken.append((stop / n_c, jump, which))
             js.settling = not model.quasi_static
         js.last_jump = jump
         js.rate = rates
