@@ -185,6 +185,10 @@ class BodyState:
     #: force (N²) added up over the steps since they were last zeroed, kept
     #: while cycles are jumped over; else (2, 0)
     load: np.ndarray = field(default_factory=lambda: np.zeros((2, 0)))
+    #: (1,) how much nearer (m) the body may come to a surface before its
+    #: deepest vertex in contact has to be measured again against its
+    #: ``depth_limit`` (docs/model.md, "Impacts"); 0: at the next step
+    impact_room: np.ndarray = field(default_factory=lambda: np.zeros(1))
 
 
 @dataclass(eq=False)

@@ -17,7 +17,7 @@ from functools import partial
 
 from . import stepper, surfaces
 from .geometry import inverted_faces
-from .kernels.loop import deepest_penetration
+from .kernels.loop import deepest_penetration, impact_check, use_impact_room
 from .model import IMPACT_DEPTH, body_contact, wear_counters
 from .output.memory import MemoryHistory
 from .wear import run_cycle_jump
@@ -50,11 +50,14 @@ def step_body(model, body, s, k):
     surfaces.update(model, body, s, t)
     touch(model, body, s, t)
     if body.depth_limit > 0.0:
-        depth, slot, vertex = deepest_penetration(s.vertices, s.pose, model.planes,
-                                                  s.vertex_planes, s.active, s.contact_state)
-        if depth > body.depth_limit:
+        slot, vertex = impact_check(s.vertices, s.pose, model.planes, s.vertex_planes, s.active,
+                                    s.contact_state, body.depth_limit, s.impact_room)
+        if slot >= 0:
             raise impact_too_deep(model, body, s, slot, vertex, t)
     body.motion.advance(s.pose, s.wrench, t, model.dt)
+    if body.depth_limit > 0.0:
+        use_impact_room(s.impact_room, s.pose, body.radius, model.surfaces.bounds,
+                        model.surfaces.terms, t, model.dt, np.zeros((2, 3)))
 
 
 def _quasi_static_step(model, body, s, k):

@@ -19,7 +19,8 @@ def _body_arrays(model, body, s):
     return (s.vertices, s.pose, body.area_vectors, model.law, body.wear_direction,
             s.contact_state, s.tangential, s.normal_force, s.friction_work, s.wear_depth,
             s.wear_volume, s.wrench, s.vertex_planes, s.hint, s.active, s.active_wear, s.cull,
-            s.cull_scratch.distance, s.load, float(body.radius), float(body.depth_limit))
+            s.cull_scratch.distance, s.load, float(body.radius), float(body.depth_limit),
+            s.impact_room)
 
 
 def _motion_arrays(model, body, s):

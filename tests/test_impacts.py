@@ -11,7 +11,8 @@ import pytest
 
 import reference
 from meshwear.cli import main
-from meshwear.kernels.loop import deepest_penetration
+from meshwear.kernels.frames import step_motion
+from meshwear.kernels.loop import deepest_penetration, impact_check, use_impact_room
 from meshwear.model import IMPACT_DEPTH, build_model, initial_state
 from meshwear.scene import load_scene
 from meshwear.simulate import NumericalError, run
@@ -64,6 +65,36 @@ def test_deepest_penetration_matches_numpy_twin(n_planes, n_meshes):
     # vertices out of contact never count, however deep
     state[:] = 0
     assert deepest_penetration(vertices, pose, planes, vertex_planes, active, state) == (0.0, -1, -1)
+
+
+def test_the_deepest_vertex_is_measured_only_when_the_motion_may_have_used_the_room():
+    """Conservative advancement: after a measurement the room below the limit
+    is known; steps take their motion off it; a new measurement comes only
+    when it may be used up."""
+    model = build_model(_drop(10.0))
+    body, state = model.bodies[0], initial_state(model)
+    s = state.bodies[0]
+    s.pose[2] = 0.01 - 0.001                     # the bottom face 1 mm into the plate
+    s.contact_state[:] = 1
+    every = np.arange(len(s.vertices), dtype=np.int64)
+    args = (s.vertices, s.pose, model.planes, s.vertex_planes, every, s.contact_state,
+            body.depth_limit)
+    room = np.zeros(1)
+    assert impact_check(*args, room) == (-1, -1)
+    assert room[0] == pytest.approx(body.depth_limit - 0.001, rel=1e-9)
+    buffer = np.zeros((2, 3))
+    step = step_motion(s.pose, body.radius, model.surfaces.bounds, model.surfaces.terms, 0.0,
+                       model.dt, buffer)
+    assert step == pytest.approx(10.0 * model.dt, rel=1e-9)
+    before = room[0]
+    use_impact_room(room, s.pose, body.radius, model.surfaces.bounds, model.surfaces.terms, 0.0,
+                    model.dt, buffer)
+    assert room[0] == pytest.approx(before - step, rel=1e-12)
+    # with room left nothing is measured, however deep the body is now
+    s.pose[2] = -0.01
+    assert impact_check(*args, room) == (-1, -1)
+    room[0] = 0.0
+    assert impact_check(*args, room)[0] == 0
 
 
 def test_an_impact_the_contact_can_stop_runs_on():

@@ -73,7 +73,7 @@ def _touch(body, plane_array):
     added to ``load``."""
     (vertices, pose, area, law, wear_direction, contact_state, tangential, normal_force,
      friction_work, wear_depth, wear_volume, wrench, vertex_planes, hint, active, active_wear,
-     cull, distance, load, radius, depth_limit) = body
+     cull, distance, load, radius, depth_limit, impact_room) = body
     slots = plane_array.shape[0] + vertex_planes.shape[0]
     if active.shape[0] * slots >= PARALLEL_THRESHOLD:
         contact_parallel(vertices, pose, plane_array, vertex_planes, active, area, law,
@@ -124,6 +124,31 @@ def deepest_penetration(vertices, pose, plane_array, vertex_planes, active, cont
             if depth > deepest:
                 deepest, where_slot, where_vertex = depth, s, i
     return deepest, where_slot, where_vertex
+
+
+@njit(cache=True)
+def impact_check(vertices, pose, plane_array, vertex_planes, active, contact_state, depth_limit,
+                 impact_room):
+    """``(slot, vertex)`` of a vertex in contact deeper than ``depth_limit``,
+    else ``(-1, -1)``. Conservative advancement: the deepest penetration is
+    measured only once the body's motion since the last measurement
+    (:func:`use_impact_room`) may have used up the room it left below the
+    limit; between, no vertex can have gone that deep."""
+    if impact_room[0] > 0.0:
+        return -1, -1
+    depth, slot, vertex = deepest_penetration(vertices, pose, plane_array, vertex_planes,
+                                              active, contact_state)
+    if depth > depth_limit:
+        return slot, vertex
+    impact_room[0] = depth_limit - depth
+    return -1, -1
+
+
+@njit(cache=True)
+def use_impact_room(impact_room, pose, radius, bounds, terms, t, dt, buffer):
+    """Take the step just moved (the body's new velocities, the surfaces'
+    speeds) off ``impact_room``."""
+    impact_room[0] -= step_motion(pose, radius, bounds, terms, t, dt, buffer)
 
 
 @njit(cache=True)
@@ -178,7 +203,8 @@ def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, 
     ``step`` found a vertex in contact deeper than ``depth_limit``: slot and
     vertex in ``report``; its contact is done, its motion is not)."""
     vertices, pose, area, law = body[0], body[1], body[2], body[3]
-    vertex_planes, active, cull, radius, depth_limit = body[12], body[14], body[16], body[19], body[20]
+    vertex_planes, active, cull, radius = body[12], body[14], body[16], body[19]
+    depth_limit, impact_room = body[20], body[21]
     kind, params, path_terms, buffer, scratch = motion
     plane_array = planes[0]
     n_planes = plane_array.shape[0]
@@ -202,12 +228,14 @@ def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, 
                                         rotation, frame, report):
                 return k, TOO_DEEP
             if depth_limit > 0.0:
-                depth, slot, vertex = deepest_penetration(vertices, pose, plane_array,
-                                                          vertex_planes, active, body[5])
-                if depth > depth_limit:
+                slot, vertex = impact_check(vertices, pose, plane_array, vertex_planes, active,
+                                            body[5], depth_limit, impact_room)
+                if slot >= 0:
                     report[0], report[1] = slot, vertex
                     return k, IMPACT
             advance_motion(kind, params, path_terms, buffer, pose, body[11], t, dt)
+            if depth_limit > 0.0:
+                use_impact_room(impact_room, pose, radius, bounds, terms, t, dt, buffer)
             k += 1
             continue
         # quasi-static: where the path puts the body at the end of the step,
