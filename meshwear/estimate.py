@@ -80,7 +80,7 @@ def _writing(model, state):
 
     with tempfile.TemporaryDirectory() as out:
         start = time.perf_counter()
-        recorder = RunRecorder(out, model)
+        recorder = RunRecorder(out, model, check_space=False)  # a temporary folder
         recorder.on_frame(model, state)
         recorder.on_sample(model, state)
         first = time.perf_counter() - start
@@ -117,11 +117,12 @@ def _jumping(model, resolved):
     """``(seconds, trial seconds, steps covered by the trial)`` of a
     cycle-jumping run: the run itself tried for :data:`JUMP_TRIAL` s (or to
     its end; longer while it has seen fewer than :data:`BOUNDED_JUMPS` jumps
-    set by a bound other than growth), the rest simulated at the trial's cost per resolved cycle with
-    the controller's rule: jumps go on growing (``GROWTH J + 1``) up to the
-    trend of the other bounds in the trial (:func:`_bound_trend`); and the remaining outputs
-    filled from jumps at the trial's cost per filled output (the writing
-    itself is :func:`_writing`'s). Never more than ``resolved``."""
+    set by a bound other than growth), the rest simulated at the trial's
+    cost per resolved cycle with the controller's rule: jumps go on growing
+    (``GROWTH J + 1``) up to the trend of the other bounds in the trial
+    (:func:`_bound_trend`); and the remaining outputs filled from jumps at
+    the trial's cost per filled output (the writing itself is
+    :func:`_writing`'s). Never more than ``resolved``."""
     from .simulate import run
     from .wear import GROWTH
 

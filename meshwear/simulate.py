@@ -11,9 +11,9 @@ in load balance first). Runs take their steps in the compiled loop
 :func:`step` is its Python reference.
 """
 
-import numpy as np
-
 from functools import partial
+
+import numpy as np
 
 from . import stepper, surfaces
 from .geometry import inverted_faces
@@ -57,7 +57,7 @@ def step_body(model, body, s, k):
     body.motion.advance(s.pose, s.wrench, t, model.dt)
     if body.depth_limit > 0.0:
         use_impact_room(s.impact_room, s.pose, body.radius, model.surfaces.bounds,
-                        model.surfaces.terms, t, model.dt, np.zeros((2, 3)))
+                        model.surfaces.terms, t, model.dt, body.motion.path.buffer)
 
 
 def _quasi_static_step(model, body, s, k):

@@ -47,6 +47,9 @@ class RunRecorder:
     state : meshwear.model.State, optional
         The run's first state: ``summary.json`` says ``"running"`` from the
         start (a run killed outright leaves that, not an older run's "ok").
+    check_space : bool
+        After the first frame, refuse a run whose outputs to come need more
+        than the folder's free space (``OSError(ENOSPC)``).
 
     Raises
     ------
@@ -58,9 +61,10 @@ class RunRecorder:
         Resuming into files that are not the stopped run's, or damaged.
     """
 
-    def __init__(self, out_dir, model, resume_until=None, state=None):
+    def __init__(self, out_dir, model, resume_until=None, state=None, check_space=True):
         self.out_dir = Path(out_dir)
         self.out_dir.mkdir(parents=True, exist_ok=True)
+        self._projected = not check_space      # the outputs to come checked against the disk
         self.lock = FolderLock(self.out_dir)
         try:
             self._open(model, resume_until, state)
@@ -98,7 +102,6 @@ class RunRecorder:
         if state is not None:
             write_json_atomic(self.out_dir / "summary.json",
                               summary(model, state, 0.0, "running", "the run has not ended"))
-        self._projected = False
 
     def on_sample(self, model, state):
         for row in history_rows(model, state):
