@@ -250,7 +250,7 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=
     if resume and not quiet:
         print(f"resuming at t = {state.time:.6g} s (step {state.step} of {model.n_steps})")
     progress = (None if quiet else _ProgressBar(model) if sys.stderr.isatty()
-                else _ProgressLines(model))
+                else _ProgressLines(model, state))
     stopping = _StopRequests(saver)
     try:
         with stopping:
@@ -481,8 +481,8 @@ class _ProgressLines:
     #: seconds between two lines
     LINE_SECONDS = 30.0
 
-    def __init__(self, model):
-        self.model, self.start = model, time.perf_counter()
+    def __init__(self, model, state=None):
+        self.model, self.state, self.start = model, state, time.perf_counter()
         self.written = self.start
 
     def __call__(self, step, n_steps):
@@ -493,8 +493,13 @@ class _ProgressLines:
         done = step / max(n_steps, 1)
         elapsed = now - self.start
         eta = f"{elapsed / done - elapsed:.0f} s" if done > 0 else "--"
+        # with cycle jumping, the last jump and what bounded it: a long run
+        # whose jumps stay short says why
+        js = getattr(self.state, "jump", None)
+        jumps = ("" if js is None else
+                 f", last jump {js.last_jump} cycles ({js.last_limit or 'none yet'})")
         print(f"meshwear: {100 * done:.1f} % t = {step * self.model.dt:.6g} s "
-              f"(step {step} of {n_steps}), {elapsed:.0f} s elapsed, eta {eta}",
+              f"(step {step} of {n_steps}), {elapsed:.0f} s elapsed, eta {eta}{jumps}",
               file=sys.stderr, flush=True)
 
     def finish(self):

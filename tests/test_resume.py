@@ -131,6 +131,15 @@ def test_progress_lines_when_not_a_terminal(tmp_path, monkeypatch, capsys):
     progress(40, 40)                      # the end: the run's own report says it
     err = capsys.readouterr().err
     assert err.startswith("meshwear: 25.0 % t = ") and "eta" in err and err.count("\n") == 1
+    # with cycle jumping, the last jump and its bound
+    from meshwear.wear import JumpState
+
+    model = build_model(load_scene(_block_scene(tmp_path, 0.05)))
+    state = initial_state(model)
+    state.jump = JumpState(last_jump=7, last_limit="drift")
+    progress = cli._ProgressLines(model, state)
+    progress(10, 40)
+    assert capsys.readouterr().err.rstrip().endswith("last jump 7 cycles (drift)")
 
 
 class _Stop(Exception):
