@@ -76,6 +76,9 @@ class JumpState:
                                                     # cycle, last measured (or None)
     part_error: list = field(default_factory=list)  # per worn counter-part (V,) estimated
                                                      # error of its depth (m)
+    part_noise: list = field(default_factory=list)  # per worn counter-part: the sampling
+                                                     # noise of its wear per cycle (m), as
+                                                     # last measured (None: not yet)
     # not saved with checkpoints: what the run has done since it (re)started,
     # for meshwear check's estimate
     last_limit: str | None = None                   # the bound that set the latest jump
@@ -160,6 +163,8 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                                part_rate=[None] * len(parts),
                                part_error=[np.zeros(len(p.depth)) for _, p in parts])
     js = state.jump
+    if len(js.part_noise) != len(parts):
+        js.part_noise = [None] * len(parts)
     for body, s in zip(model.bodies, state.bodies):
         if s.load.shape[1] != len(s.wear_depth):
             s.load = np.zeros((2, len(s.wear_depth)))
@@ -376,7 +381,7 @@ def _part_limit(model, parts, part_rates, js, measures, tolerance, end):
     penetration (the counter is extrapolated, not relieved), and a part
     vertex sinking by at most SPACING_FRACTION of its spacing per jump."""
     bounds = {}
-    for (j, part), rate, previous in zip(parts, part_rates, js.part_rate):
+    for k, ((j, part), rate, previous) in enumerate(zip(parts, part_rates, js.part_rate)):
         if rate.max(initial=0.0) <= 0.0:
             continue
         if previous is None:
@@ -384,9 +389,9 @@ def _part_limit(model, parts, part_rates, js, measures, tolerance, end):
         # a counter vertex's wear in one cycle is sampled by the steps of the
         # passes over it, and differs from cycle to cycle by that sampling
         # (a pass over a track's edge takes a few steps); a jump multiplies
-        # one cycle's, so it is taken only where that noise, estimated by
-        # the last two measurements, stays within the tolerance
-        if _noise(rate, previous) > tolerance * rate.max():
+        # one cycle's, so it is taken only where that noise stays within the
+        # tolerance
+        if _counter_noise(js, k, rate, previous) > tolerance * rate.max():
             return 0, "counter noise"
         jump, which = choose_jump(rate, previous, js.gap, np.zeros(len(rate)), tolerance,
                                   js.last_jump, end, stability=False)
@@ -428,7 +433,7 @@ def _jump_parts(model, parts, before_parts, part_rates, js, jump):
         previous = js.part_rate[k]
         js.part_error[k] += _slope_error(rate, previous, js.gap, jump)
         if previous is not None:
-            js.part_error[k] += jump * _noise(rate, previous)
+            js.part_error[k] += jump * _counter_noise(js, k, rate, previous)
         spans.append({name: (span[name], getattr(part, name).copy()) for name in PART_JUMPED})
     return spans
 
@@ -437,6 +442,20 @@ def _noise(rate, previous):
     """Half the largest change of a counter vertex's wear per cycle between
     two measurements: the sampling noise of one cycle's wear, at most."""
     return 0.5 * float(np.abs(rate - previous).max())
+
+
+def _counter_noise(js, k, rate, previous):
+    """The sampling noise of worn counter-part ``k``'s wear per cycle
+    (:func:`_noise`), measured between two consecutive resolved cycles.
+    Across a jump the change between the two measurements also holds the
+    drift of the wear rate over the jumped cycles (the slope criterion's
+    part), which grows with the jump: taken for noise, it refused jumps
+    once they were long and the controller fell back to jumps of a few
+    cycles (the gear pair past a few thousand revolutions). There the noise
+    last measured between consecutive cycles stands."""
+    if js.gap <= 1.0 or js.part_noise[k] is None:
+        js.part_noise[k] = _noise(rate, previous)
+    return js.part_noise[k]
 
 
 #: the arrays of a worn counter-part a jump extrapolates

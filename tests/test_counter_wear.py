@@ -494,3 +494,24 @@ def test_a_turning_body_swept_over_a_counter_part_s_edge_rests_on_its_top(tmp_pa
     assert s.vertex_planes[0][touching][:, 1, 2].min() > 0.999
     assert 0.000999 < s.pose[2] < 0.001
     assert state.parts[0].volume.sum() / s.wear_volume.sum() == pytest.approx(0.5, rel=1e-12)
+
+
+def test_counter_noise_is_measured_between_consecutive_cycles_only():
+    """Across a jump the change of a counter vertex's wear per cycle holds the
+    rate's drift over the jumped cycles too (the slope criterion's part): the
+    noise measured last between consecutive resolved cycles stands there, or
+    long jumps would be refused as noisy (the gear pair's jumps collapsed)."""
+    from meshwear.wear import JumpState, _counter_noise
+
+    previous = np.array([1.0e-9, 2.0e-9, 0.0])
+    js = JumpState(gap=1.0, part_noise=[None])
+    consecutive = previous + np.array([0.0, 2.0e-11, 0.0])          # sampling: 1 % at most
+    assert _counter_noise(js, 0, consecutive, previous) == pytest.approx(1e-11)
+    js.gap = 65.0                                                     # after a jump of 64
+    drifted = previous * 1.3                                          # the rate moved on
+    assert _counter_noise(js, 0, drifted, previous) == pytest.approx(1e-11)
+    js.gap = 1.0                                                      # consecutive again
+    assert _counter_noise(js, 0, drifted, previous) == pytest.approx(0.5 * 0.3 * 2e-9)
+    # no measurement between consecutive cycles yet (a resumed run): the change stands
+    js = JumpState(gap=65.0, part_noise=[None])
+    assert _counter_noise(js, 0, drifted, previous) == pytest.approx(0.5 * 0.3 * 2e-9)
