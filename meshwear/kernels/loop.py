@@ -103,13 +103,13 @@ def deepest_penetration(vertices, pose, plane_array, vertex_planes, active, cont
     deepest, where_slot, where_vertex = 0.0, -1, -1
     for k in range(active.shape[0]):
         i = active[k]
+        bx, by, bz = vertices[i, 0], vertices[i, 1], vertices[i, 2]
+        px = pose[0] + r00 * bx + r01 * by + r02 * bz
+        py = pose[1] + r10 * bx + r11 * by + r12 * bz
+        pz = pose[2] + r20 * bx + r21 * by + r22 * bz
         for s in range(contact_state.shape[0]):
             if contact_state[s, i] == 0:
                 continue
-            bx, by, bz = vertices[i, 0], vertices[i, 1], vertices[i, 2]
-            px = pose[0] + r00 * bx + r01 * by + r02 * bz
-            py = pose[1] + r10 * bx + r11 * by + r12 * bz
-            pz = pose[2] + r20 * bx + r21 * by + r22 * bz
             # the plane under the vertex, read as scalars as the contact kernel does
             if s < n_planes:
                 ox, oy, oz = plane_array[s, 0, 0], plane_array[s, 0, 1], plane_array[s, 0, 2]
