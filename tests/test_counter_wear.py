@@ -515,3 +515,51 @@ def test_counter_noise_is_measured_between_consecutive_cycles_only():
     # no measurement between consecutive cycles yet (a resumed run): the change stands
     js = JumpState(gap=65.0, part_noise=[None])
     assert _counter_noise(js, 0, drifted, previous) == pytest.approx(0.5 * 0.3 * 2e-9)
+
+
+def _listed(grid, keys, starts, items, p):
+    """The faces the grid cell holding point ``p`` lists."""
+    idx = ((p - grid[0:3]) // grid[3]).astype(int)
+    key = idx[0] + int(grid[4]) * (idx[1] + int(grid[5]) * idx[2])
+    if len(keys) == 0:
+        return set(items[starts[key]:starts[key + 1]].tolist())
+    j = np.searchsorted(keys, key)
+    return set(items[starts[j]:starts[j + 1]].tolist()) if j < len(keys) and keys[j] == key else set()
+
+
+def test_a_worn_surface_is_binned_anew_only_once_its_wear_passes_the_grid_s_slack(tmp_path):
+    """A worn counter mesh's grid lists the faces a slack beyond the reach
+    its queries cut at: while no vertex has sunk farther than that since the
+    binning (the gear pair's wheel over 10^5 revolutions), each cell still
+    lists every face within the reach of its points and the grid is kept (a
+    binning of that wheel costs 1.5-2 s a jump); past it, it is binned anew."""
+    import trimesh
+
+    from meshwear.surfaces.mesh import WEAR_SLACK
+
+    model = build_model(load_scene(_scene(tmp_path)))
+    state = initial_state(model)
+    j = next(k for k, p in enumerate(state.parts) if p is not None)
+    surface, part = model.surfaces.per_vertex[j], state.parts[j]
+    surface.ensure_reach(5e-4)
+    grid = surface.grid
+    reach, slack = grid[0][7], WEAR_SLACK * surface.reach
+    assert reach == surface.reach
+    rng = np.random.default_rng(0)
+    part.depth[:] = rng.uniform(0.0, slack, len(part.depth))        # unevenly, within it
+    part.vertices[:] = surface.reference_vertices - part.depth[:, None] * surface.vertex_normals
+    surface.rebin()
+    assert surface.grid is grid
+    tri = part.vertices[surface.faces]
+    picks = rng.choice(len(part.vertices), 60, replace=False)
+    points = part.vertices[picks] + rng.uniform(-0.6, 0.6, (60, 3)) * reach
+    for p in points:
+        d = np.linalg.norm(trimesh.triangles.closest_point(tri, np.repeat(p[None], len(tri), 0))
+                           - p, axis=1)
+        within = set(np.flatnonzero(d <= reach).tolist())
+        assert within, "the sample point is near the worn surface"
+        assert within <= _listed(*grid, p)
+    part.depth[picks[0]] = 1.01 * slack
+    surface.rebin()
+    assert surface.grid is not grid
+    assert np.array_equal(surface.binned_depth, part.depth)

@@ -34,6 +34,11 @@ MARGIN_FRACTION = 0.01
 #: the margin is at least this many times the largest relative motion of one
 #: step, so a vertex always meets a surface within reach before it touches
 STEPS_IN_MARGIN = 10.0
+#: the steps' queries look this fraction of the active set's margin away
+#: (:func:`query_reach`): the cells of a mesh's grid list the faces within
+#: the reach, so a query's cost grows with it (the refresh's own look goes
+#: the whole margin, on a grid of its own)
+QUERY_FRACTION = 0.3
 
 #: slots of :attr:`meshwear.model.BodyState.cull`
 CULL_MARGIN, CULL_TIME, CULL_POSE = 0, 1, slice(2, 9)
@@ -216,6 +221,15 @@ def margin_of(scene, body):
     return MARGIN_FRACTION * float(np.linalg.norm(np.ptp(body.reference_vertices, axis=0)))
 
 
+def query_reach(model, body, s):
+    """How far (m) the steps' queries look for the surfaces under the active
+    vertices: the body's margin, at least :data:`QUERY_FRACTION` of the
+    active set's (three steps' motion: a vertex has its face a few steps
+    before it can touch, and one pressed in is far less deep). Beyond it a
+    vertex has no plane, so no contact."""
+    return max(body_margin(model, body), QUERY_FRACTION * s.cull[CULL_MARGIN])
+
+
 def step_motion(model, body, s, t):
     """Upper bound (m) on how far a vertex of ``body`` moves relative to any
     surface in one step."""
@@ -250,14 +264,15 @@ def refresh(model, body, s, t):
         # a worn surface moving within itself (turning, sliding) brings its
         # less worn parts under a vertex: nearer by at most its deepest wear
         reach = margin + (float(surface.part.depth.max()) if surface.worn else 0.0)
-        surface.ensure_reach(reach)
+        if surface.worn:
+            surface.rebin()     # if its wear since the last binning passed the grid's slack
         candidates = surface.candidates(surfaces, body, s.pose, x, t, reach)
         if not len(candidates):
             continue
         scratch.planes[candidates] = 0.0
         scratch.hint[candidates] = -1
-        surface.fill(s.vertices, s.pose, candidates, scratch.planes, scratch.distance,
-                     scratch.hint, t)
+        surface.fill_within(reach, s.vertices, s.pose, candidates, scratch.planes,
+                            scratch.distance, scratch.hint, t)
         near[candidates[scratch.distance[candidates] < reach]] = True
     active = np.flatnonzero(near)
     left = np.setdiff1d(s.active, active, assume_unique=True)
@@ -293,8 +308,9 @@ def update(model, body, s, t):
 
 def query(model, body, s, t):
     """The planes of the per-vertex surfaces under the active vertices at ``t``."""
+    reach = query_reach(model, body, s)
     for j, surface in enumerate(model.surfaces.per_vertex):
-        surface.ensure_reach(max(body_margin(model, body), s.cull[CULL_MARGIN]))
+        surface.ensure_reach(reach)
         surface.fill(s.vertices, s.pose, s.active, s.vertex_planes[j], s.cull_scratch.distance,
                      s.hint[j], t)
 

@@ -248,6 +248,12 @@ class CounterSurface:
     def ensure_reach(self, reach):
         """Make queries find the surface up to ``reach`` (m) away (meshes bin faces)."""
 
+    def fill_within(self, reach, body_vertices, pose, active, out, distance, hint, t):
+        """:meth:`fill` finding the surface up to ``reach`` (m) away (the
+        active set's refresh; meshes keep a grid for it)."""
+        self.ensure_reach(reach)
+        self.fill(body_vertices, pose, active, out, distance, hint, t)
+
     # ---------------------------------------------------------- drawing
     def drawing(self, extent):
         """(vertices, faces) to draw it, in its own frame; ``extent`` (m) sizes
