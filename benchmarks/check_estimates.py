@@ -32,7 +32,7 @@ def main(argv=None):
     parser.add_argument("--skip", action="append", default=[],
                         help="scene stems left out (repeatable)")
     args = parser.parse_args(argv)
-    scenes = args.scenes or sorted((ROOT / "examples").rglob("*.toml"))
+    scenes = [s.resolve() for s in args.scenes] or sorted((ROOT / "examples").rglob("*.toml"))
     scenes = [s for s in scenes if s.stem not in args.skip]
     print(f"{'scene':<36}{'estimate (s)':>14}{'run (s)':>10}{'error':>9}", flush=True)
     worst = 0.0
