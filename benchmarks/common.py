@@ -37,11 +37,13 @@ def replace_section(page, start, end, section):
     page.write_text(text)
 
 
-def write_measured(name, rows, figure, caption):
+def write_measured(name, rows, figure, caption, section=None):
     """The measured section of docs/examples/``name``.md, as
     benchmarks/``name``.py writes it: a table of ``rows`` ((quantity,
-    measured) pairs) and the figure docs/img/``figure`` under ``caption``."""
-    start, end = f"<!-- {name}:start -->", f"<!-- {name}:end -->"
+    measured) pairs) and the figure docs/img/``figure`` under ``caption``;
+    ``section`` names the section's markers if the page has more than one."""
+    section = section or name
+    start, end = f"<!-- {section}:start -->", f"<!-- {section}:end -->"
     lines = [start, "", f"<!-- written by benchmarks/{name}.py -->", "",
              "| quantity | measured |", "|---|---:|"]
     lines += [f"| {quantity} | {value} |" for quantity, value in rows]

@@ -10,7 +10,13 @@ sliding (the friction work over the friction coefficient), writes
 docs/img/gear_pair.png and the measured section of docs/examples/gear_pair.md,
 prints the figures and, last, one JSON line.
 
-    .venv/bin/python benchmarks/gear_pair.py [--revolutions N] [--save NPZ]   # minutes
+    .venv/bin/python benchmarks/gear_pair.py [--revolutions N] [--save NPZ]   # a minute
+
+or reads a finished run of it, of any duration (the section "After 10^5
+revolutions" of the page and its figure):
+
+    meshwear run examples/gear_pair.toml -o OUT --set run.duration=62831.85307179586
+    .venv/bin/python benchmarks/gear_pair.py --from OUT
 """
 
 import argparse
@@ -29,6 +35,7 @@ from meshwear.scene import load_scene  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "gear_pair.toml"
 FIGURE = ROOT / "docs" / "img" / "gear_pair.png"
+LONG_FIGURE = ROOT / "docs" / "img" / "gear_pair_long.png"
 #: module, teeth and pressure angle of the example's gears (m, -, rad)
 MODULE, TEETH, ALPHA = 0.002, 20, np.radians(20.0)
 PITCH = 0.5 * MODULE * TEETH
@@ -38,36 +45,46 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--revolutions", type=float, default=None,
                         help="instead of the example's 300 (no page written)")
+    parser.add_argument("--from", dest="source", type=Path, default=None, metavar="OUT",
+                        help="read a finished run of the example (any duration) from its "
+                        "output folder instead of running it; writes the long-run section "
+                        "of the page and docs/img/gear_pair_long.png")
     parser.add_argument("--save", default=None, metavar="NPZ",
                         help="also save the flank profiles there")
     args = parser.parse_args(argv)
     scene = load_scene(SCENE)
-    if args.revolutions is not None:
-        rate = scene.bodies[0].path.rotation.rate
-        scene = scene.set("run.duration", args.revolutions * 2.0 * np.pi / rate)
-    model, state, result, wall = timed_run(scene)
     rate = scene.bodies[0].path.rotation.rate
+    if args.source is not None:
+        model, depths, totals, result = read_run(scene, args.source)
+        wall = result["wall_time"]
+    else:
+        if args.revolutions is not None:
+            scene = scene.set("run.duration", args.revolutions * 2.0 * np.pi / rate)
+        model, state, result, wall = timed_run(scene)
+        pinion, wheel = state.bodies[0], state.parts[0]
+        depths = {"pinion": pinion.wear_depth, "wheel": wheel.depth}
+        totals = {"pinion": (pinion.wear_volume.sum(), pinion.friction_work.sum()),
+                  "wheel": (wheel.volume.sum(), wheel.work.sum())}
     friction = scene.contact.friction
-    pinion, wheel = state.bodies[0], state.parts[0]
+    coefficients = {"pinion": scene.wear.coefficient,
+                    "wheel": model.surfaces.per_vertex[0].law[1]}
     profiles = {
         "pinion": flank_profile(model.bodies[0].reference_vertices - model.bodies[0].origin,
-                                pinion.wear_depth),
-        "wheel": flank_profile(model.surfaces.per_vertex[0].reference_vertices, wheel.depth),
+                                depths["pinion"]),
+        "wheel": flank_profile(model.surfaces.per_vertex[0].reference_vertices,
+                               depths["wheel"]),
     }
     row = {
-        "wall": wall, "revolutions": rate * state.time / (2.0 * np.pi),
+        "wall": wall, "revolutions": rate * result["time"] / (2.0 * np.pi),
         "resolved_revolutions": result["resolved_cycles"], "jumps": result["jumps"],
         "error_estimate": result["error_estimate"], "jump_limits": result["jump_limits"],
-        "pinion_vertices": len(pinion.wear_depth), "wheel_vertices": len(wheel.depth),
-        # Archard: volume = k x sum of N |ds| = k x friction work / mu in full slip
-        "pinion_volume_error": float(pinion.wear_volume.sum()
-                                     / (scene.wear.coefficient * pinion.friction_work.sum()
-                                        / friction) - 1.0),
-        "wheel_volume_error": float(wheel.volume.sum()
-                                    / (model.surfaces.per_vertex[0].law[1] * wheel.work.sum()
-                                       / friction) - 1.0),
-        "pinion_depth": float(pinion.wear_depth.max()), "wheel_depth": float(wheel.depth.max()),
+        "pinion_vertices": len(depths["pinion"]), "wheel_vertices": len(depths["wheel"]),
     }
+    for name, (volume, work) in totals.items():
+        # Archard: volume = k x sum of N |ds| = k x friction work / mu in full slip
+        row[f"{name}_volume_error"] = float(volume / (coefficients[name] * work / friction)
+                                            - 1.0)
+        row[f"{name}_depth"] = float(np.max(depths[name]))
     for name, p in profiles.items():
         for key in ("pitch_over_max", "addendum_max", "dedendum_max", "addendum_at",
                     "dedendum_at"):
@@ -85,10 +102,31 @@ def main(argv=None):
     if args.save:
         np.savez(args.save, **{f"{n}_{k}": v for n, p in profiles.items()
                                for k, v in p.items() if isinstance(v, np.ndarray)})
-    if args.revolutions is None:
-        plot(profiles, row)
-        write_page(row)
+    if args.source is not None:
+        plot(profiles, row, LONG_FIGURE)
+        write_page(row, "gear_pair_long", LONG_FIGURE)
+    elif args.revolutions is None:
+        plot(profiles, row, FIGURE)
+        write_page(row, "gear_pair", FIGURE)
     print(json.dumps({"benchmark": "gear_pair", **row}))
+
+
+def read_run(scene, out):
+    """The model of ``scene``, each gear's wear depth in the last frame of a
+    finished run in folder ``out``, each one's (worn volume, friction work)
+    and the run's summary.json."""
+    from meshwear.model import build_model
+    from meshwear.output.export import read_frame, series_frames
+
+    result = json.loads((out / "summary.json").read_text())
+    if result["status"] != "ok":
+        raise SystemExit(f"{out}: the run has not ended well (status {result['status']!r})")
+    depths = {name: np.asarray(read_frame(series_frames(out, name)[-1][1])
+                               .point_data["wear_depth"], float)
+              for name in ("pinion", "wheel")}
+    totals = {"pinion": result["bodies"]["pinion"], "wheel": result["surfaces"]["wheel"]}
+    totals = {k: (v["wear_volume"], v["friction_work"]) for k, v in totals.items()}
+    return build_model(scene), depths, totals, result
 
 
 def flank_profile(vertices, depth):
@@ -114,7 +152,7 @@ def flank_profile(vertices, depth):
             "dedendum_at": float(radii[below][np.argmax(mean[below])])}
 
 
-def plot(profiles, row):
+def plot(profiles, row, figure):
     fig, ax = plt.subplots(figsize=(6.4, 3.8))
     for k, (name, p) in enumerate(profiles.items()):
         ax.plot(1e3 * p["radius"], 1e6 * p["mean"], "-o", ms=2.5, color=f"C{k}",
@@ -126,11 +164,11 @@ def plot(profiles, row):
     ax.set_title(f"Spur gear pair after {row['revolutions']:.0f} revolutions: flank wear")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(FIGURE, dpi=110)
+    fig.savefig(figure, dpi=110)
     plt.close(fig)
 
 
-def write_page(r):
+def write_page(r, section, figure):
     write_measured("gear_pair", [
         ("wall time (build, run, outputs)",
          f"{r['wall']:.0f} s: {r['revolutions']:.0f} revolutions, "
@@ -150,7 +188,7 @@ def write_page(r):
         ("deepest below the pitch circle (dedendum), pinion / wheel",
          f"{1e6 * r['pinion_dedendum_max']:.3f} µm at {1e3 * r['pinion_dedendum_at']:.2f} mm"
          f" / {1e6 * r['wheel_dedendum_max']:.3f} µm at {1e3 * r['wheel_dedendum_at']:.2f} mm"),
-    ], FIGURE.name, "the worn flank profiles")
+    ], figure.name, "the worn flank profiles", section=section)
 
 
 if __name__ == "__main__":

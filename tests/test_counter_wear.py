@@ -563,3 +563,39 @@ def test_a_worn_surface_is_binned_anew_only_once_its_wear_passes_the_grid_s_slac
     surface.rebin()
     assert surface.grid is not grid
     assert np.array_equal(surface.binned_depth, part.depth)
+
+
+def test_a_worn_surface_attached_to_a_new_state_is_queried_there_at_every_reach(tmp_path):
+    """A worn mesh queries the part state it is attached to, on the steps'
+    grid and on the active-set refresh's own farther-reaching one (a second
+    run of the same model, as ``meshwear check``'s trials do)."""
+    from meshwear.kernels.nearest import face_frames
+
+    model = build_model(load_scene(_scene(tmp_path)))
+    initial_state(model)
+    j = next(k for k, p in enumerate(model.surfaces.per_vertex) if p.worn)
+    surface = model.surfaces.per_vertex[j]
+    surface.ensure_reach(2e-4)
+    points = np.array([[0.004, 0.0, 0.0005], [0.0, 0.005, 0.0008], [-0.003, -0.003, 0.0012]])
+    pose = np.zeros(13)
+    pose[3] = 1.0
+
+    def distances(reach):
+        n = len(points)
+        out, distance = np.zeros((n, 3, 3)), np.full(n, np.inf)
+        surface.fill_within(reach, points, pose, np.arange(n), out, distance,
+                            np.full(n, -1), 0.0)
+        return distance
+
+    near, far = distances(1e-4), distances(2e-3)       # the steps' grid, then a grid of its own
+    assert surface.far is not None and np.isinf(near[1:]).all()
+    np.testing.assert_allclose(far, points[:, 2], rtol=1e-9)
+    state = initial_state(model)                        # a new run: a new part state
+    part = state.parts[j]
+    top = surface.reference_vertices[:, 2] > 0.0       # its top face sinks by 0.1 mm
+    part.depth[top] = 1e-4
+    part.vertices[:] = surface.reference_vertices - part.depth[:, None] * surface.vertex_normals
+    part.frames[:] = face_frames(part.vertices, surface.faces)
+    np.testing.assert_allclose(distances(2e-3), points[:, 2] + 1e-4, rtol=1e-9)
+    points[:, 2] = 1e-4                               # and on the steps' grid
+    np.testing.assert_allclose(distances(1e-4), 2e-4, rtol=1e-9)

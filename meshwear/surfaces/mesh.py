@@ -166,6 +166,8 @@ class MeshSurface(CounterSurface):
         :class:`meshwear.model.PartState`): its vertices and face frames."""
         self.vertices, self.frames, self.part = part.vertices, part.frames, part
         self._compiled = None
+        if self.far is not None:
+            self.far[3] = None                    # its tuple holds the arrays too
 
     def face_weights(self, points, face, t):
         """Barycentric weights (k, 3) of world ``points`` (k, 3) at ``t`` on
