@@ -113,6 +113,16 @@ def _bound_trend(taken):
     return float(np.exp(np.median(j - b * p))), b
 
 
+def _per_cycle(elapsed, js, step, n_c):
+    """Seconds of a resolved cycle, its jump's work included, from a trial
+    of ``elapsed`` s that stopped at ``step`` (``js``: its
+    :class:`meshwear.wear.JumpState`): the steps of the cycle it stopped in
+    count too, their time being in the trial's (not counting them made the
+    gear pair's estimate 25 % high: a trial of 2.5 revolutions read as 2)."""
+    steps = js.resolved_steps + max(0, step - js.cycle_start)
+    return (elapsed - js.fill_seconds) / max(steps / n_c, 1.0)
+
+
 def _jumping(model, resolved):
     """``(seconds, trial seconds, steps covered by the trial)`` of a
     cycle-jumping run: the run itself tried for :data:`JUMP_TRIAL` s (or to
@@ -150,8 +160,7 @@ def _jumping(model, resolved):
     # them goes with the outputs left, not with the cycles
     per_output = js.fill_seconds / max(js.filled_outputs, 1)
     remaining = int((model.output_steps > state.step).sum())
-    # a resolved cycle, its jump's work included
-    per_cycle = (elapsed - js.fill_seconds) / max(js.resolved_steps / n_c, 1.0)
+    per_cycle = _per_cycle(elapsed, js, state.step, n_c)
     settle = 0 if model.quasi_static else 1      # a dynamic run resolves a cycle after a jump
     position, total = state.step / n_c, model.n_steps / n_c
     bound = _bound_trend(js.taken)

@@ -86,6 +86,7 @@ class JumpState:
     filled_outputs: int = 0                         # outputs filled from jumps
     taken: list = field(default_factory=list)       # the jumps taken: (cycle it starts at,
                                                     # cycles, the bound that set it)
+    cycle_start: int = 0                            # the step the cycle being resolved began at
 
 
 def penetration(model, body, s):
@@ -169,7 +170,7 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
         if s.load.shape[1] != len(s.wear_depth):
             s.load = np.zeros((2, len(s.wear_depth)))
     while state.step < model.n_steps:
-        start = state.step
+        start = js.cycle_start = state.step
         before = [(s.wear_depth.copy(), s.vertices.copy(), s.wear_volume.copy(),
                    s.friction_work.copy()) for s in state.bodies]
         before_parts = [(p.depth.copy(), p.volume.copy(), p.work.copy()) for _, p in parts]

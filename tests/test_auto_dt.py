@@ -141,3 +141,17 @@ def test_check_s_estimate_counts_the_outputs_and_caps_jumps_at_resolved(tmp_path
     e = estimate_run(jumped)
     assert 0 < e.stepping <= e.per_step * jumped.n_steps
     assert e.trial_covered > 0
+
+
+def test_a_jump_trial_stopped_inside_a_cycle_counts_its_steps():
+    """The cost of a resolved cycle from ``meshwear check``'s jumping trial:
+    a trial that stopped half-way through its third resolved cycle resolved
+    2.5 cycles, not 2; the outputs filled from jumps are costed apart."""
+    from meshwear.estimate import _per_cycle
+    from meshwear.wear import JumpState
+
+    n_c = 100
+    js = JumpState(resolved_steps=2 * n_c, cycle_start=3 * n_c, fill_seconds=1.0)
+    assert _per_cycle(11.0, js, 3 * n_c + n_c // 2, n_c) == pytest.approx(10.0 / 2.5)
+    assert _per_cycle(11.0, js, 3 * n_c, n_c) == pytest.approx(10.0 / 2.0)   # at a cycle's start
+    assert _per_cycle(3.0, JumpState(cycle_start=0), n_c // 4, n_c) == 3.0   # less than one: one

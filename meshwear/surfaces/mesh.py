@@ -187,16 +187,15 @@ class MeshSurface(CounterSurface):
         weights /= weights.sum(axis=1, keepdims=True)
         return weights, corners
 
-    def rebin(self, force=False):
+    def rebin(self):
         """Bin the faces anew where they are now (a worn part after a jump or
         a restart) if some vertex has sunk farther than a grid's slack
-        (:data:`WEAR_SLACK` of its reach) since they were binned for it, or
-        if ``force``. Binning the gear pair's wheel (18 600 faces, a 3.3 mm
+        (:data:`WEAR_SLACK` of its reach) since they were binned for it. Binning the gear pair's wheel (18 600 faces, a 3.3 mm
         reach) took 1.5-2 s a jump; its wear over 10^5 revolutions is a few µm."""
-        if self.grid is not None and (force or self._sunk(self.binned_depth, self.reach)):
+        if self.grid is not None and self._sunk(self.binned_depth, self.reach):
             self.grid, self.binned_depth = self._bin(self.reach)
             self._compiled = None
-        if self.far is not None and (force or self._sunk(self.far[2], self.far[0])):
+        if self.far is not None and self._sunk(self.far[2], self.far[0]):
             self.far = None                   # binned anew when next asked for
 
     def _sunk(self, binned_depth, reach):
