@@ -8,7 +8,7 @@ loaded side, the shaft's all round. Writes docs/img/shaft_in_worn_bushing.png
 and the measured section of docs/examples/shaft_in_worn_bushing.md, prints
 the figures and, last, one JSON line.
 
-    .venv/bin/python benchmarks/shaft_in_worn_bushing.py      # about 40 s here
+    .venv/bin/python benchmarks/shaft_in_worn_bushing.py      # about 25 s here
 """
 
 import json
