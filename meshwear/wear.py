@@ -281,13 +281,15 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None):
     if fastest <= 0.0 or any(a is None for a in js.alpha):
         return 0, "accuracy", None
     bounds = {"end": float(end), "growth": float(could)}
-    drift = 0.0
+    # per body, each measured vertex's drift of its wear per cycle, rho_i pbar_i
+    drifts = []
     for m, previous in zip(measures, js.alpha):
         previous = previous[m.index]
         both = (m.mean > 0.0) & (previous > 0.0) & (m.alpha > 0.0)
-        if both.any():
-            rho = np.abs(m.alpha[both] - previous[both]) / max(js.gap, 1.0)
-            drift = max(drift, float((rho * m.mean[both]).max()))
+        rate = np.zeros(len(m.index))
+        rate[both] = np.abs(m.alpha[both] - previous[both]) / max(js.gap, 1.0) * m.mean[both]
+        drifts.append(rate)
+    drift = max(float(d.max(initial=0.0)) for d in drifts)
     if drift > 0.0:
         bounds["drift"] = 2.0 * tolerance * fastest / drift
     which = min(bounds, key=bounds.get)
@@ -299,6 +301,9 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None):
         worst = max(float(e.max(initial=0.0)) for _, _, e in results) / (tolerance * jump
                                                                           * fastest)
         if worst <= 1.0:
+            # the error estimate: step doubling's, and the drift's over the jump
+            results = [(w, z, e + 0.5 * d * jump * jump)
+                       for (w, z, e), d in zip(results, drifts)]
             return jump, which, _spread(measures, rates, jump, results)
         # the error grows like J^2, its allowance like J
         jump, which = int(jump * min(0.9 / worst, 0.5 if worst > 2.0 else 0.9)), "accuracy"

@@ -304,3 +304,27 @@ def test_a_track_touched_once_a_turn_jumps_as_resolved(tmp_path, measured):
     # the whole track wears (not only the vertices on the ball when a jump starts)
     track = w_ref > 0.5 * w_ref.max()
     assert track.sum() > 100 and np.all(w[track] > 0.95 * w_ref[track])
+
+
+def test_an_implicit_jump_s_error_estimate_holds_the_drift_it_was_bounded_by():
+    """Implicit jumps bound J by each vertex's drift of its wear per unit
+    penetration, rho_i pbar_i J^2 / 2 <= tol J r_max; that error is added to
+    the step-doubling one in the estimate (without it the gear pair's 10^5
+    revolutions estimated half the error measured against a tighter run)."""
+    from meshwear.jumps import BodyJump, implicit
+    from meshwear.wear import JumpState, _choose_implicit
+
+    k, p = 3, 1e-6
+    alpha = np.full(k, 1e-6)                        # wear per cycle per unit penetration
+    m = BodyJump(index=np.arange(k), alpha=alpha.copy(), depth=np.full(k, p),
+                 mean=np.full(k, p), now=np.full(k, p), normal=np.tile([0.0, 0.0, 1.0], (k, 1)),
+                 stiffness=np.ones(k), member=np.ones(k, bool), touched=np.zeros(k, bool),
+                 beta=np.zeros(k), load=0.0, guided=False)
+    previous = alpha.copy()
+    previous[0] *= 1.001                            # vertex 0's changed by 0.1 % over 10 cycles
+    js = JumpState(alpha=[previous], gap=10.0)
+    jump, which, results = _choose_implicit([m], [alpha * p], js, 10**6, 100, 0.01)
+    assert (jump, which) == (100, "growth")         # the drift allows 200
+    _, _, doubling = implicit(m, jump)
+    drift = 0.5 * (1e-3 * 1e-6 / 10.0) * p * jump ** 2
+    np.testing.assert_allclose(results[0][2], doubling + np.array([drift, 0.0, 0.0]), rtol=1e-9)
