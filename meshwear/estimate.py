@@ -118,7 +118,7 @@ def _per_cycle(elapsed, js, step, n_c):
     of ``elapsed`` s that stopped at ``step`` (``js``: its
     :class:`meshwear.wear.JumpState`): the steps of the cycle it stopped in
     count too, their time being in the trial's (not counting them made the
-    gear pair's estimate 25 % high: a trial of 2.5 revolutions read as 2)."""
+    gear pair's estimate 25 % high: a trial of 3 revolutions read as 2)."""
     steps = js.resolved_steps + max(0, step - js.cycle_start)
     return (elapsed - js.fill_seconds) / max(steps / n_c, 1.0)
 
