@@ -127,6 +127,20 @@ def rotation_entries(q):
 ONE_PLANE = ONE_SURFACE = False
 
 
+@njit(cache=True, inline="always")
+def plane_under(planes, vertex_planes, n_planes, s, i):
+    """Point and normal of contact slot ``s`` under vertex ``i``, as six
+    scalars: uniform plane ``s`` or, past the ``n_planes`` planes, the
+    per-vertex plane (a zero normal: no face within reach). Read as scalars:
+    a view would cost a reference count per pair."""
+    if s < n_planes:
+        return (planes[s, 0, 0], planes[s, 0, 1], planes[s, 0, 2],
+                planes[s, 1, 0], planes[s, 1, 1], planes[s, 1, 2])
+    m = s - n_planes
+    return (vertex_planes[m, i, 0, 0], vertex_planes[m, i, 0, 1], vertex_planes[m, i, 0, 2],
+            vertex_planes[m, i, 1, 0], vertex_planes[m, i, 1, 1], vertex_planes[m, i, 1, 2])
+
+
 def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear_direction,
              contact_state, tangential, normal_force,
              friction_work, wear_depth, wear_volume, wrench):
@@ -174,19 +188,14 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
             # the counter-surface's plane under A, read as scalars (an array
             # view here would cost a reference count per pair): point o,
             # normal n, velocity, and n in the body frame (mx, my, mz)
+            ox, oy, oz, nx, ny, nz = plane_under(planes, vertex_planes, n_planes, s, i)
             if s < n_planes:
-                ox, oy, oz = planes[s, 0, 0], planes[s, 0, 1], planes[s, 0, 2]
-                nx, ny, nz = planes[s, 1, 0], planes[s, 1, 1], planes[s, 1, 2]
                 svx, svy, svz = planes[s, 2, 0], planes[s, 2, 1], planes[s, 2, 2]
                 mx, my, mz = local[s, 0], local[s, 1], local[s, 2]
             else:
                 # a mesh counter-surface: the plane of its face under this
                 # vertex (a zero normal: no face within reach)
                 m = s - n_planes
-                ox, oy = vertex_planes[m, i, 0, 0], vertex_planes[m, i, 0, 1]
-                oz = vertex_planes[m, i, 0, 2]
-                nx, ny = vertex_planes[m, i, 1, 0], vertex_planes[m, i, 1, 1]
-                nz = vertex_planes[m, i, 1, 2]
                 svx, svy = vertex_planes[m, i, 2, 0], vertex_planes[m, i, 2, 1]
                 svz = vertex_planes[m, i, 2, 2]
                 mx = r00 * nx + r10 * ny + r20 * nz

@@ -42,7 +42,8 @@ import numpy as np
 from numba import njit
 
 from .balance import balance_offset
-from .contact import PARALLEL_THRESHOLD, contact_parallel, contact_serial, rotation_entries
+from .contact import (PARALLEL_THRESHOLD, contact_parallel, contact_serial, plane_under,
+                      rotation_entries)
 from .counter import fill_planes
 from .counter_wear import wear_counter
 from .frames import moved_since_refresh, plane_rows, step_motion, surface_frame
@@ -110,16 +111,7 @@ def deepest_penetration(vertices, pose, plane_array, vertex_planes, active, cont
         for s in range(contact_state.shape[0]):
             if contact_state[s, i] == 0:
                 continue
-            # the plane under the vertex, read as scalars as the contact kernel does
-            if s < n_planes:
-                ox, oy, oz = plane_array[s, 0, 0], plane_array[s, 0, 1], plane_array[s, 0, 2]
-                nx, ny, nz = plane_array[s, 1, 0], plane_array[s, 1, 1], plane_array[s, 1, 2]
-            else:
-                m = s - n_planes
-                ox, oy = vertex_planes[m, i, 0, 0], vertex_planes[m, i, 0, 1]
-                oz = vertex_planes[m, i, 0, 2]
-                nx, ny = vertex_planes[m, i, 1, 0], vertex_planes[m, i, 1, 1]
-                nz = vertex_planes[m, i, 1, 2]
+            ox, oy, oz, nx, ny, nz = plane_under(plane_array, vertex_planes, n_planes, s, i)
             depth = -((px - ox) * nx + (py - oy) * ny + (pz - oz) * nz)
             if depth > deepest:
                 deepest, where_slot, where_vertex = depth, s, i
