@@ -15,26 +15,51 @@ __version__ = "0.1.0"
 
 
 def _numba_cache_dir():
-    """Where numba caches the compiled kernels. By default next to their
-    source (``__pycache__``), else in the user's cache folder; where neither
-    can be written (a system-wide or container install, a user without a
-    writable HOME) numba refuses to import them, so this picks a writable
-    folder first: ``$NUMBA_CACHE_DIR`` if set, else the package folder if
-    writable, else ``meshwear-numba`` in the user's cache or the temporary
-    folder. None when the package folder will do."""
+    """Where numba caches the compiled kernels: a folder named by a digest
+    of the kernels' source, so that a change to any kernel compiles every
+    kernel anew (numba keys a cached function by its own file only: a loop
+    that calls a changed kernel of another file would run the old one).
+    In ``kernels/__pycache__`` beside their source if it can be written,
+    else in ``meshwear-numba-<uid>`` in the user's cache or the temporary
+    folder (a system-wide or container install, a user without a writable
+    HOME); folders of other digests there are removed. None when
+    ``$NUMBA_CACHE_DIR`` is set (the user's choice stands)."""
     if _os.environ.get("NUMBA_CACHE_DIR"):
         return None
-    here = _os.path.dirname(_os.path.abspath(__file__))
-    if _writable(_os.path.join(here, "kernels", "__pycache__")):
-        return None
+    import hashlib
     import tempfile
 
+    here = _os.path.dirname(_os.path.abspath(__file__))
+    kernels = _os.path.join(here, "kernels")
+    digest = hashlib.sha1()
+    for name in sorted(_os.listdir(kernels)):
+        if name.endswith(".py"):
+            with open(_os.path.join(kernels, name), "rb") as f:
+                digest.update(name.encode() + b"\0" + f.read())
     user = _os.environ.get("XDG_CACHE_HOME") or _os.path.join(_os.path.expanduser("~"), ".cache")
-    for base in (user, tempfile.gettempdir()):
-        folder = _os.path.join(base, f"meshwear-numba-{getattr(_os, 'getuid', lambda: 0)()}")
+    uid = getattr(_os, "getuid", lambda: 0)()
+    for base in (_os.path.join(kernels, "__pycache__"),
+                 _os.path.join(user, f"meshwear-numba-{uid}"),
+                 _os.path.join(tempfile.gettempdir(), f"meshwear-numba-{uid}")):
+        folder = _os.path.join(base, f"numba-{digest.hexdigest()[:16]}")
         if _writable(folder):
+            _forget_others(base, folder)
             return folder
     return None
+
+
+def _forget_others(base, keep):
+    """Remove the cache folders of other kernel sources under ``base`` (best effort)."""
+    import shutil
+
+    try:
+        names = _os.listdir(base)
+    except OSError:
+        return
+    for name in names:
+        path = _os.path.join(base, name)
+        if name.startswith("numba-") and path != keep:
+            shutil.rmtree(path, ignore_errors=True)
 
 
 def _writable(folder):
