@@ -1,10 +1,12 @@
 """How far the steps' face lookups look: their cost against the old reach.
 
 On a mesh counter-surface each step finds the face under every active
-vertex in a grid whose cells list the faces within the lookup's reach.
-The steps now look :data:`meshwear.surfaces.active.QUERY_FRACTION` of the
-active set's margin away (the refresh looks the whole margin, on a grid of
-its own); before, the steps looked the whole margin too. This runs the
+vertex (its own face, a walk to the next, or a search of the faces' tree
+within the lookup's reach; with the uniform grid it replaced, whose cells
+listed the faces within the reach, the reach set the cost). The steps look
+:data:`meshwear.surfaces.active.QUERY_FRACTION` of the active set's margin
+away (the refresh looks the whole margin); before, the steps looked the
+whole margin too. This runs the
 example scenes with mesh counter-surfaces both ways in the same process
 (``QUERY_FRACTION`` = 1 is the old lookup), interleaved, the best of three,
 and prints per step, vertex-steps/s and the ratio, and how far the two

@@ -310,6 +310,8 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=
 def _check(scene_path, overrides=()):
     import numpy as np
 
+    from .remesh import describe_refinement
+
     scene, model, limit = _prepare(scene_path, overrides)
     print(f"scene {scene.source}: ok (format 1, mode {scene.run.mode})")
     for key, value in overrides:
@@ -318,8 +320,12 @@ def _check(scene_path, overrides=()):
         mass = f"{b.mass:.6g} kg" if np.isfinite(b.mass) else "n/a (open mesh, not integrated)"
         print(f"  body {b.name!r}: {len(b.tributary_area)} contact points, {len(b.faces)} faces, "
               f"mass {mass}, motion {config.motion}")
+        if b.refinement:
+            print(f"    {describe_refinement(b.refinement)}")
     for surface, config in zip(model.surfaces.slots, _slot_configs(scene, model)):
         print(f"  {_surface_summary(surface, config)}, {surface.describe()}")
+        if getattr(surface, "refinement", None):
+            print(f"    {describe_refinement(surface.refinement)}")
     stable = (f"largest stable dt {limit:.3g} s" if np.isfinite(limit)
               else "no stability limit (quasi-static)" if model.quasi_static
               else "no stability limit (nothing integrated in time)")

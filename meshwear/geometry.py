@@ -401,6 +401,49 @@ def _cylinder(radius, height, sections):
     return _arrays(vertices, faces.reshape(-1, 3))
 
 
+#: a cylinder's face is on its side (not a cap) where its normal is this
+#: close to perpendicular to the axis (cap faces: |n_z| = 1, side faces 0)
+SIDE = 0.5
+
+
+def snap_to_primitive(shape, vertices, faces):
+    """The vertices of a refined ``sphere`` or ``cylinder`` primitive (its
+    own frame, as :func:`primitive` makes it) put on its exact surface: all
+    of a sphere's at its radius; a cylinder's on its side (those of a face
+    whose normal is perpendicular to the axis, the rims included) at its
+    radius from the axis, keeping their height. Refining splits the flat
+    facets, so without this the new vertices sag towards the axis by up to
+    R (1 - cos(pi / sections)). Other shapes and mesh files: unchanged."""
+    if shape is None or shape.type not in ("sphere", "cylinder"):
+        return vertices
+    vertices = np.array(vertices, dtype=float)
+    if shape.type == "sphere":
+        vertices *= shape.radius / np.linalg.norm(vertices, axis=1)[:, None]
+        return vertices
+    side = np.zeros(len(vertices), bool)
+    side[faces[np.abs(face_normals(vertices, faces)[:, 2]) < SIDE].ravel()] = True
+    radial = np.linalg.norm(vertices[side, 0:2], axis=1)
+    vertices[side, 0:2] *= (shape.radius / radial)[:, None]
+    return vertices
+
+
+def facet_sag(shape, vertices, faces):
+    """(m,) how far (m) each face of a ``sphere`` or ``cylinder`` primitive
+    lies inside its exact surface (largest at its edges' midpoints and its
+    centre); None for other shapes (a box is exact) and mesh files (their
+    surface is their facets)."""
+    if shape is None or shape.type not in ("sphere", "cylinder"):
+        return None
+    tri = vertices[faces]
+    points = np.concatenate([0.5 * (tri + np.roll(tri, -1, axis=1)),
+                             tri.mean(axis=1, keepdims=True)], axis=1)       # (m, 4, 3)
+    if shape.type == "sphere":
+        return shape.radius - np.linalg.norm(points, axis=2).min(axis=1)
+    sag = shape.radius - np.linalg.norm(points[..., 0:2], axis=2).min(axis=1)
+    side = np.abs(face_normals(vertices, faces)[:, 2]) < SIDE
+    return np.where(side, sag, 0.0)
+
+
 def _edge_keys(F, n):
     """(m·3,) int: undirected key min·n + max of edge k = (F[:, k], F[:, k+1])."""
     G = np.roll(F, -1, axis=1)

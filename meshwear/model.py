@@ -12,12 +12,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import geometry, remesh, surfaces
+from .kernels import tree
 from .kernels.contact import LAW_SLOTS, all_vertices, contact, make_law, rotation_entries
 from .kernels.counter_wear import wear_counter
 from .kernels.laws import code_of
 from .kernels.nearest import face_frames
 from .motion import BalancedMotion, FixedMotion, FreeMotion, GuidedMotion, Path, PrescribedMotion
 from .scene import SceneError
+from .surfaces.base import quaternion_matrix
 
 #: fraction of the estimated stability limit accepted as the largest stable dt
 STABILITY_MARGIN = 0.9
@@ -63,6 +65,8 @@ class BodyModel:
         A body moved by its dynamics (free, guided) stops the run when a
         vertex in contact is deeper than this (m): :data:`IMPACT_DEPTH` of
         its thinnest extent; 0 for bodies placed by their path.
+    refinement : dict or None
+        What ``resolution`` did (:func:`meshwear.remesh.refine_part`).
     """
 
     name: str
@@ -80,6 +84,7 @@ class BodyModel:
     period: float | None
     radius: float = 0.0
     depth_limit: float = 0.0
+    refinement: dict | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -258,6 +263,17 @@ def build_model(scene):
         except geometry.MeshError as err:
             key = f"surface[{j}].mesh" if s.mesh is not None else f"surface[{j}].shape"
             raise SceneError(scene.source, key, str(err)) from None
+    # the bodies are refined where they face the surfaces, then the mesh
+    # surfaces where the bodies can reach them over the run
+    bodies = _build_bodies(scene, surfaces.SurfaceSet(built))
+    for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
+        if getattr(s, "resolution", None) is not None and isinstance(surface,
+                                                                     surfaces.MeshSurface):
+            try:
+                built[j] = surface.refined(s, _surface_faces_to_refine(scene, surface, bodies))
+            except geometry.MeshError as err:
+                key = f"surface[{j}].mesh" if s.mesh is not None else f"surface[{j}].shape"
+                raise SceneError(scene.source, key, str(err)) from None
     for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
         if getattr(s, "wear", False):
             if scene.wear.acceleration == "cycle_jump" and scene.wear.jump == "explicit":
@@ -270,15 +286,6 @@ def build_model(scene):
     plane_array = surface_set.planes
 
     run = scene.run
-    bodies = []
-    for j, b in enumerate(scene.bodies):
-        try:
-            bodies.append(_build_body(scene, j, b, surface_set))
-        except geometry.MeshError as err:
-            # the mesh loader names the mesh file; add the scene file and the key
-            key = f"body[{j}].mesh" if b.mesh is not None else f"body[{j}].shape"
-            raise SceneError(scene.source, key, str(err)) from None
-    bodies = tuple(bodies)
     c = scene.contact
     (ct, ct_area), (dt_point, dt_area) = c.tangential
     law = make_law(friction=c.friction, static_friction=c.static_friction,
@@ -328,6 +335,81 @@ def build_model(scene):
                  quasi_static=quasi_static, dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
                  frame_steps=_even_steps(n_steps, run.frames), period=period,
                  cycle_steps=cycle_steps)
+
+
+def _build_bodies(scene, surface_set):
+    bodies = []
+    for j, b in enumerate(scene.bodies):
+        try:
+            bodies.append(_build_body(scene, j, b, surface_set))
+        except geometry.MeshError as err:
+            # the mesh loader names the mesh file; add the scene file and the key
+            key = f"body[{j}].mesh" if b.mesh is not None else f"body[{j}].shape"
+            raise SceneError(scene.source, key, str(err)) from None
+    return tuple(bodies)
+
+
+#: a worn surface's reach is sampled at this many instants at least, and at
+#: most at this many: denser until no body vertex moves farther than the
+#: margin between two of them
+REACH_SAMPLES = (64, 4096)
+
+
+def _surface_faces_to_refine(scene, surface, bodies):
+    """Which faces of a mesh surface ``resolution`` refines, as a selection
+    made anew at each pass of the refinement: those within the active-set
+    margin of a body at some instant of the run (sampled over one cycle when
+    the moving parts share one period, else over the run, until no vertex
+    moves more than the margin between samples; their spacing added to the
+    margin). None (all faces) if a body is free (it may land anywhere) or
+    moves too fast to sample."""
+    from scipy.spatial import cKDTree
+
+    if any(b.motion.dynamic_axes == "all" for b in bodies):
+        return None
+    periods = {round(p, 12) for p in _periods(scene)}
+    window = scene.run.duration
+    if len(periods) == 1:
+        window = min(window, periods.pop())
+    low, high = surface.vertices.min(axis=0), surface.vertices.max(axis=0)
+    clouds, reach = [], 0.0
+    for b in bodies:
+        margin = surfaces.margin_of(scene, b)
+        pose = b.initial_pose.copy()
+        n = REACH_SAMPLES[0]
+        while True:
+            points = []
+            for t in np.linspace(0.0, window, n + 1):
+                b.motion.place(pose, t)
+                rotation, frame = surface.motion.frame(t)
+                x = pose[0:3] + b.reference_vertices @ quaternion_matrix(pose[3:7]).T
+                points.append((x - frame[0]) @ rotation)
+            step = max(float(np.linalg.norm(q - p, axis=1).max())
+                       for p, q in zip(points, points[1:]))
+            if step <= margin or n >= REACH_SAMPLES[1]:
+                break
+            n *= 2
+        if step > 4.0 * margin:
+            return None
+        r = margin + 0.5 * step
+        points = np.concatenate(points)
+        near = np.all((points >= low - r) & (points <= high + r), axis=1)
+        clouds.append(points[near])
+        reach = max(reach, r)
+    cloud = np.concatenate(clouds)
+    if not len(cloud):
+        return np.zeros(len(surface.faces), bool)
+    index = cKDTree(cloud)
+
+    def select(vertices, faces):
+        # a face is within reach of a point if its centre is within reach
+        # and the face's own size of it
+        tri = vertices[faces]
+        centre = tri.mean(axis=1)
+        size = np.linalg.norm(tri - centre[:, None], axis=2).max(axis=1)
+        return index.query(centre)[0] <= reach + size
+
+    return select
 
 
 def _periods(scene):
@@ -406,10 +488,10 @@ def _even_steps(n_steps, count):
 def _build_body(scene, index, body, surface_set):
     key = f"body[{index}]"
     vertices, faces = geometry.load_part(body)
+    refinement = None
     if body.resolution is not None:
-        vertices, faces = remesh.refine(vertices, faces, body.resolution,
-                                          face_mask=_faces_to_refine(scene, body, vertices, faces,
-                                                                     surface_set))
+        vertices, faces, refinement = remesh.refine_part(
+            body, vertices, faces, _faces_to_refine(scene, body, vertices, faces, surface_set))
     needs_inertia = body.motion in ("free", "guided")
     area = geometry.tributary_areas(vertices, faces)
     try:
@@ -468,7 +550,8 @@ def _build_body(scene, index, body, surface_set):
         mass=float(mass), inertia=inertia, origin=-com, initial_pose=pose, motion=motion,
         period=path.period, radius=float(np.linalg.norm(body_vertices, axis=1).max()),
         depth_limit=(IMPACT_DEPTH * _thinnest(body_vertices)
-                     if motion.dynamic_axes is not None else 0.0))
+                     if motion.dynamic_axes is not None else 0.0),
+        refinement=refinement)
 
 
 #: a vertex in contact deeper than this fraction of its body's thinnest

@@ -6,7 +6,9 @@ builds on and which does not import it).
 
 import numpy as np
 
+from . import geometry
 from .geometry import MeshError, _arrays, _doubled_areas, _edge_keys, _edge_lengths
+from .kernels.tree import spatial_order
 
 #: area of the largest triangle whose edges are all <= 1 (equilateral)
 _LARGEST_UNIT_TRIANGLE = np.sqrt(3.0) / 4.0
@@ -49,7 +51,7 @@ def face_limit(memory=None):
     return MAX_FACES, "the largest refinement meshwear makes"
 
 
-def refine(vertices, faces, resolution, face_mask=None, max_faces=None):
+def refine(vertices, faces, resolution, face_mask=None, max_faces=None, return_mask=False):
     """Split triangles until every edge of the selected faces is <= ``resolution``.
 
     Conforming longest-edge bisection (Rivara): a face that needs refining has
@@ -62,7 +64,10 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=None):
     are left, so a closed mesh stays closed. After each pass,
     Delaunay edge flips between coplanar selected faces keep the triangles well
     shaped, so a long thin CAD triangle costs about what a well-shaped face of
-    the same area does. The surface itself never changes.
+    the same area does. The surface itself never changes. The vertices and
+    faces of a mesh it refined come out sorted along a Morton curve
+    (:func:`meshwear.kernels.tree.spatial_order`: the face lookups and the
+    contact loop then read memory nearby).
 
     Parameters
     ----------
@@ -70,28 +75,37 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=None):
     faces : (m, 3) int
     resolution : float
         Largest edge length allowed on selected faces (m).
-    face_mask : (m,) bool, optional
+    face_mask : (m,) bool or callable, optional
         Faces to refine (default all). Children of selected faces stay selected;
-        unselected faces are split only where needed to stay conforming.
+        unselected faces are split only where needed to stay conforming. A
+        callable ``face_mask(vertices, faces)`` selects anew after each pass
+        (a big face of which only a part is to be refined: its children
+        away from that part are left).
     max_faces : int, optional
         Refuse (MeshError) rather than build a larger mesh: at once when the
         selected area alone needs more faces (a triangle with edges <=
         ``resolution`` covers sqrt(3)/4 resolution² at most), else as soon as
         a pass makes more. Default: :func:`face_limit` (this machine's
         available memory, at most :data:`MAX_FACES`).
+    return_mask : bool
+        Also return which faces come from selected ones.
 
     Returns
     -------
     vertices : (k, 3) float
     faces : (l, 3) int
+    mask : (l,) bool, if ``return_mask``
     """
     V, F = _arrays(vertices, faces)
     if not resolution > 0:
         raise ValueError(f"resolution must be positive, got {resolution!r}")
-    mask = np.ones(len(F), bool) if face_mask is None else np.asarray(face_mask, bool).copy()
+    select = face_mask if callable(face_mask) else None
+    mask = (np.ones(len(F), bool) if face_mask is None else select(V, F) if select is not None
+            else np.asarray(face_mask, bool).copy())
     if mask.shape != (len(F),):
         raise ValueError(f"face_mask has shape {mask.shape}, expected ({len(F)},)")
-    area = 0.5 * float(_doubled_areas(V, F[mask]).sum())
+    # (a selection made anew each pass may keep far less than its first one)
+    area = 0.0 if select is not None else 0.5 * float(_doubled_areas(V, F[mask]).sum())
     cell = _LARGEST_UNIT_TRIANGLE * resolution**2     # 0.0 for a subnormal resolution
     least = area / cell if cell > 0.0 else float("inf")
     why = "the limit asked"
@@ -100,11 +114,19 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=None):
     if not least <= max_faces:
         raise MeshError(f"refining to resolution {resolution:g} m needs at least {least:.3g} "
                         f"faces, more than {max_faces} ({why}); give a coarser resolution")
+    first_count = len(F)
     while True:
+        if select is not None and len(F) > first_count:
+            mask = select(V, F)
         lengths = _edge_lengths(V, F)
         need = mask & (lengths.max(axis=1) > resolution)
         if not need.any():
-            return _arrays(V, F)
+            # a mesh it refined comes out in space order; one it did not, as it was
+            if len(F) > first_count:
+                V, F, by_face = spatial_order(V, F)
+                mask = mask[by_face]
+            V, F = _arrays(V, F)
+            return (V, F, mask) if return_mask else (V, F)
         longest = lengths.argmax(axis=1)
         edges, eid = np.unique(_edge_keys(F, len(V)), return_inverse=True)
         eid = eid.reshape(-1, 3)
@@ -220,3 +242,52 @@ def _flip_coplanar(V, F, mask, active, rounds=100):
         active[f1[cand]] = True
         active[f2[cand]] = True
     return F
+
+
+#: a refined sphere or cylinder has its edges short enough that its facets
+#: sag at most this fraction of the resolution
+SAG_FRACTION = 0.01
+
+
+def refine_part(config, vertices, faces, face_mask=None):
+    """A body's or mesh surface's mesh refined to its ``resolution`` where
+    ``face_mask`` says (all faces by default), a primitive's vertices on its
+    exact surface (:func:`meshwear.geometry.snap_to_primitive`), a sphere's or cylinder's
+    edges short enough there for its facets to sag at most
+    :data:`SAG_FRACTION` of the resolution; and a summary for ``meshwear
+    check``: ``refined_vertices`` (the vertices of the refined faces),
+    ``vertices``, ``resolution``, ``shape`` (its type, None for a mesh
+    file), ``sag`` (m, the largest facet sag where refined) and
+    ``sag_elsewhere`` (m; both None but for a sphere or cylinder: mesh files
+    keep their facets)."""
+    resolution = float(config.resolution)
+    if config.shape is not None and config.shape.type in ("sphere", "cylinder"):
+        # a triangle with edges e on a sphere of radius R sags at most
+        # rc^2 / (2 R) <= e^2 / (6 R) (rc its circumradius, <= e / sqrt 3):
+        # edges short enough for SAG_FRACTION of the resolution
+        resolution = min(resolution, float(np.sqrt(6.0 * config.shape.radius * SAG_FRACTION
+                                                   * resolution)))
+    vertices, faces, mask = refine(vertices, faces, resolution, face_mask=face_mask,
+                                          return_mask=True)
+    vertices = geometry.snap_to_primitive(config.shape, vertices, faces)
+    sag = geometry.facet_sag(config.shape, vertices, faces)
+    info = {"vertices": len(vertices), "refined_vertices": int(len(np.unique(faces[mask]))),
+            "resolution": float(config.resolution), "sag": None, "sag_elsewhere": None,
+            "shape": config.shape.type if config.shape is not None else None}
+    if sag is not None:
+        info["sag"] = float(sag[mask].max(initial=0.0))
+        info["sag_elsewhere"] = float(sag[~mask].max(initial=0.0))
+    return np.ascontiguousarray(vertices), faces, info
+
+
+def describe_refinement(info):
+    """One line for ``meshwear check`` from :func:`refine_part`'s summary."""
+    if not info:
+        return ""
+    text = (f"refined to {info['resolution']:.3g} m: {info['refined_vertices']} of "
+            f"{info['vertices']} vertices")
+    if info["sag"] is None:
+        return text + (" (a mesh file keeps its facets)" if info["shape"] is None else "")
+    return (text + f"; facet sag {info['sag']:.2g} m where refined "
+            f"({info['sag'] / info['resolution']:.2g} of the resolution), "
+            f"{info['sag_elsewhere']:.2g} m elsewhere")

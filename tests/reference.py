@@ -266,17 +266,37 @@ def closest_points(tri, points):
     return best, bary
 
 
+def _walk(y, h, prev, edges, normals, faces, over, tracking, steps):
+    """The face a walk from face ``h`` reaches: across the edge the foot of
+    ``y`` lies farthest beyond, while the next face shares the edge and its
+    normal is within ``tracking`` of ``prev``, until the foot is over a face
+    (``steps`` faces at most)."""
+    f = h
+    for _ in range(steps):
+        beyond = edges[f, :, 0:3] @ y - edges[f, :, 3]
+        edge = int(np.argmax(beyond))
+        if beyond[edge] <= over:
+            break
+        a, b = faces[f, edge], faces[f, (edge + 1) % 3]
+        shared = [g for g in range(len(faces)) if g != f and {a, b} <= set(faces[g].tolist())]
+        if len(shared) != 1 or normals[shared[0]] @ prev < tracking:
+            break
+        f = shared[0]
+    return f
+
+
 def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
                    face_normals, corner_normals, reach, out, distance, hint, fixed=False,
-                   tracking=0.5, tie=1e-9, release=16.0):
+                   tracking=0.5, tie=1e-9, release=16.0, walk=32):
     """Same contract as :func:`meshwear.kernels.nearest.nearest_planes`, by
-    brute force over every face (no grid); ``fixed`` only lets the kernel
+    brute force over every face (no tree); ``fixed`` only lets the kernel
     reuse what it wrote, so the twin ignores it."""
     R = quaternion_matrix(pose[3:7])
     x = pose[0:3] + body_vertices[active] @ R.T
     y = (x - motion[0]) @ rotation
     previous = out[active, 1].copy()
     tri = counter_vertices[faces]
+    edges = face_frames(counter_vertices, faces)[:, 1:4]
     F = len(faces)
     for row, i in enumerate(active):
         points = np.repeat(y[row][None], F, axis=0)
@@ -305,8 +325,23 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
                 delta[h] < 0.0 and -delta[h] > release * _inside(tri[h], foot[h])):
             kept = h                  # still over the face it had: it stays there
         else:
-            kept = pick(eligible) if tracked else -1
-            if (kept >= 0 and delta[kept] < 0.0
+            kept = -1
+            onto = False
+            if tracked:
+                # the face the walk from its last face reaches: it stays on
+                # it as on its own (not deep under it); else on the nearest
+                # face it can stay on if the walk reached one, or on one as
+                # near as the nearest face
+                f = _walk(y[row], h, prev, edges, face_normals, faces, 1e-9 * reach, tracking,
+                          walk) if h >= 0 else -1
+                if f >= 0 and eligible[f] and not (
+                        delta[f] < 0.0 and -delta[f] > release * _inside(tri[f], foot[f])):
+                    kept, onto = f, True
+                elif f >= 0 and eligible[f]:
+                    kept = pick(eligible)
+                elif nearest >= 0:
+                    kept = pick(eligible & (d2 <= d2[nearest] * (1 + 2 * tie)))
+            if (kept >= 0 and not onto and delta[kept] < 0.0
                     and delta[kept] ** 2 > release ** 2 * d2[nearest]):
                 kept = -1             # deep under it, near another face: let go
         best = kept if kept >= 0 else nearest

@@ -483,17 +483,28 @@ def test_a_turning_body_swept_over_a_counter_part_s_edge_rests_on_its_top(tmp_pa
     pressed on a worn pin. Its vertices sweep in over the pin's edge at the
     depth of the elastic approach, nearer the side face at first; deep under
     it, they let go of it for the top face (nearest.RELEASE), so the disc
-    stays in balance on the pin's top (it sank through the pin before)."""
+    stays in balance on the pin's top (it sank through the pin before). A
+    vertex that came in this very step (it starts in stick) may still be
+    nearer the side than RELEASE allows (the pin's side is exact, the
+    vertex 0.3 um under the top and up to 16 times that inside the side):
+    it pushes on the side for that step only, with a fraction of the load."""
+    from meshwear.kernels.contact import SLIP
+
     path = tmp_path / "disc_over_pin.toml"
     path.write_text(DISC_OVER_A_WORN_PIN)
     model = build_model(load_scene(path))
     state = run(model, initial_state(model))
     s = state.bodies[0]
     touching = s.normal_force[0] > 0.0
-    assert touching.sum() > 30
-    assert s.vertex_planes[0][touching][:, 1, 2].min() > 0.999
+    sliding = touching & (s.contact_state[0] == SLIP)
+    assert sliding.sum() > 30
+    assert s.vertex_planes[0][sliding][:, 1, 2].min() > 0.999
+    on_side = touching & (s.vertex_planes[0][:, 1, 2] < 0.999)
+    assert s.normal_force[0][on_side].sum() < 0.01 * s.normal_force[0].sum()
     assert 0.000999 < s.pose[2] < 0.001
-    assert state.parts[0].volume.sum() / s.wear_volume.sum() == pytest.approx(0.5, rel=1e-12)
+    # the wear-volume identity (docs/physics-tests.md: 1e-9): to 1e-11 here, the
+    # vertices on the side face pressing with their area facing down
+    assert state.parts[0].volume.sum() / s.wear_volume.sum() == pytest.approx(0.5, rel=1e-9)
 
 
 def test_counter_noise_is_measured_between_consecutive_cycles_only():
@@ -517,24 +528,11 @@ def test_counter_noise_is_measured_between_consecutive_cycles_only():
     assert _counter_noise(js, 0, drifted, previous) == pytest.approx(0.5 * 0.3 * 2e-9)
 
 
-def _listed(grid, keys, starts, items, p):
-    """The faces the grid cell holding point ``p`` lists."""
-    idx = ((p - grid[0:3]) // grid[3]).astype(int)
-    key = idx[0] + int(grid[4]) * (idx[1] + int(grid[5]) * idx[2])
-    if len(keys) == 0:
-        return set(items[starts[key]:starts[key + 1]].tolist())
-    j = np.searchsorted(keys, key)
-    return set(items[starts[j]:starts[j + 1]].tolist()) if j < len(keys) and keys[j] == key else set()
-
-
-def test_a_worn_surface_is_binned_anew_only_once_its_wear_passes_the_grid_s_slack(tmp_path):
-    """A worn counter mesh's grid lists the faces a slack beyond the reach
-    its queries cut at: while no vertex has sunk farther than that since the
-    binning (the gear pair's wheel over 10^5 revolutions), each cell still
-    lists every face within the reach of its points and the grid is kept (a
-    binning of that wheel costs 1.5-2 s a jump); past it, it is binned anew."""
-    import trimesh
-
+def test_a_worn_surface_s_tree_is_fitted_anew_only_once_its_wear_passes_the_slack(tmp_path):
+    """A worn counter mesh grows its tree's boxes by a slack: while no vertex
+    has sunk farther than that since they were fitted (the gear pair's
+    wheel over 10^5 revolutions), every box still holds its faces and the
+    boxes are kept; past it, they are fitted anew (in place, O(F))."""
     from meshwear.surfaces.mesh import WEAR_SLACK
 
     model = build_model(load_scene(_scene(tmp_path)))
@@ -542,32 +540,36 @@ def test_a_worn_surface_is_binned_anew_only_once_its_wear_passes_the_grid_s_slac
     j = next(k for k, p in enumerate(state.parts) if p is not None)
     surface, part = model.surfaces.per_vertex[j], state.parts[j]
     surface.ensure_reach(5e-4)
-    grid = surface.grid
-    reach, slack = grid[0][7], WEAR_SLACK * surface.reach
-    assert reach == surface.reach
+    boxes, nodes, order = surface.tree
+    slack = WEAR_SLACK * surface.reach
+    assert surface.pad == slack and surface.search[0] == surface.reach
+    fitted = boxes.copy()
     rng = np.random.default_rng(0)
     part.depth[:] = rng.uniform(0.0, slack, len(part.depth))        # unevenly, within it
     part.vertices[:] = surface.reference_vertices - part.depth[:, None] * surface.vertex_normals
     surface.rebin()
-    assert surface.grid is grid
-    tri = part.vertices[surface.faces]
-    picks = rng.choice(len(part.vertices), 60, replace=False)
-    points = part.vertices[picks] + rng.uniform(-0.6, 0.6, (60, 3)) * reach
-    for p in points:
-        d = np.linalg.norm(trimesh.triangles.closest_point(tri, np.repeat(p[None], len(tri), 0))
-                           - p, axis=1)
-        within = set(np.flatnonzero(d <= reach).tolist())
-        assert within, "the sample point is near the worn surface"
-        assert within <= _listed(*grid, p)
-    part.depth[picks[0]] = 1.01 * slack
+    assert np.array_equal(boxes, fitted)
+
+    def held():
+        for k in np.flatnonzero(nodes[:, 1] > 0):
+            first, count = nodes[k]
+            tri = part.vertices[surface.faces[order[first:first + count]]].reshape(-1, 3)
+            if not ((tri >= boxes[k, 0:3]).all() and (tri <= boxes[k, 3:6]).all()):
+                return False
+        return True
+
+    assert held()
+    part.depth[:] *= 2.0                                               # past it
+    part.vertices[:] = surface.reference_vertices - part.depth[:, None] * surface.vertex_normals
+    assert not held(), "the case must move faces out of their boxes"
     surface.rebin()
-    assert surface.grid is not grid
-    assert np.array_equal(surface.binned_depth, part.depth)
+    assert surface.tree[0] is boxes and held()
+    assert np.array_equal(surface.fitted_depth, part.depth)
 
 
 def test_a_worn_surface_attached_to_a_new_state_is_queried_there_at_every_reach(tmp_path):
     """A worn mesh queries the part state it is attached to, on the steps'
-    grid and on the active-set refresh's own farther-reaching one (a second
+    reach and at the active-set refresh's farther one (a second
     run of the same model, as ``meshwear check``'s trials do)."""
     from meshwear.kernels.nearest import face_frames
 
@@ -587,8 +589,8 @@ def test_a_worn_surface_attached_to_a_new_state_is_queried_there_at_every_reach(
                             np.full(n, -1), 0.0)
         return distance
 
-    near, far = distances(1e-4), distances(2e-3)       # the steps' grid, then a grid of its own
-    assert surface.far is not None and np.isinf(near[1:]).all()
+    near, far = distances(1e-4), distances(2e-3)       # the steps' reach, then farther
+    assert np.isinf(near[1:]).all()
     np.testing.assert_allclose(far, points[:, 2], rtol=1e-9)
     state = initial_state(model)                        # a new run: a new part state
     part = state.parts[j]
@@ -597,5 +599,5 @@ def test_a_worn_surface_attached_to_a_new_state_is_queried_there_at_every_reach(
     part.vertices[:] = surface.reference_vertices - part.depth[:, None] * surface.vertex_normals
     part.frames[:] = face_frames(part.vertices, surface.faces)
     np.testing.assert_allclose(distances(2e-3), points[:, 2] + 1e-4, rtol=1e-9)
-    points[:, 2] = 1e-4                               # and on the steps' grid
+    points[:, 2] = 1e-4                               # and at the steps' reach
     np.testing.assert_allclose(distances(1e-4), 2e-4, rtol=1e-9)

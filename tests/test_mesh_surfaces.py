@@ -48,7 +48,9 @@ def test_nearest_planes_match_brute_force_twin(smooth):
     normals = trimesh.Trimesh(V, F, process=False).face_normals.copy()
     vnormals = (nearest.corner_normals(V, F, normals) if smooth else np.zeros((0, 3, 3)))
     reach = 2e-3
-    grid = nearest.build_grid(V, F, normals, reach)
+    from meshwear.kernels import tree
+
+    grid = (np.array([reach, 0.0]), *tree.build(V, F, 1e-12), tree.face_neighbours(F))
     rotation = _rotation(rng)
     motion = np.array([[0.001, -0.002, 0.003], [0.1, 0.0, -0.05], [0.0, 3.0, 10.0],
                        [0.0, 0.001, 0.0]])
@@ -128,29 +130,68 @@ def test_nearest_planes_match_brute_force_twin(smooth):
     assert (hint == twin_hint).all()
 
 
-def test_grid_cells_list_every_face_within_reach():
-    """The superset property the one-cell lookup relies on, including long
-    thin slanted triangles (a CAD tessellation)."""
+def _leaf_faces(boxes, nodes, order, p, reach):
+    """The faces of every leaf whose box comes within ``reach`` of ``p``
+    (what the kernel's search can reach), by a walk of the whole tree."""
+    listed, stack = set(), [0]
+    while stack:
+        k = stack.pop()
+        gap = np.maximum(np.maximum(boxes[k, 0:3] - p, p - boxes[k, 3:6]), 0.0)
+        if gap @ gap > reach * reach:
+            continue
+        first, count = nodes[k]
+        if count:
+            listed.update(order[first:first + count].tolist())
+        else:
+            stack += [first, first + 1]
+    return listed
+
+
+def test_face_tree_holds_every_face_once_in_boxes_that_hold_them():
+    """The properties the kernel's search relies on, on long thin slanted
+    triangles (a CAD tessellation): every face in one leaf, each box holding
+    its faces and its children, so the leaves whose boxes come within reach
+    of a point list every face within reach of it."""
+    from meshwear.kernels import tree
+
     rng = np.random.default_rng(1)
     V = rng.uniform(-0.05, 0.05, (60, 3))
     F = rng.integers(0, 60, (80, 3))
     F = F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 0] != F[:, 2])]
-    normals = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    boxes, nodes, order = tree.build(V, F, 0.0)
+    assert sorted(order.tolist()) == list(range(len(F)))
+    leaves = nodes[:, 1] > 0
+    assert nodes[leaves, 1].sum() == len(F) and nodes[leaves, 1].max() <= tree.LEAF
+    for k in np.flatnonzero(leaves):
+        first, count = nodes[k]
+        tri = V[F[order[first:first + count]]].reshape(-1, 3)
+        assert (tri >= boxes[k, 0:3]).all() and (tri <= boxes[k, 3:6]).all()
+    for k in np.flatnonzero(~leaves):
+        for c in nodes[k, 0] + np.arange(2):
+            assert c > k
+            assert (boxes[c, 0:3] >= boxes[k, 0:3]).all() and (boxes[c, 3:6] <= boxes[k, 3:6]).all()
     reach = 0.004
-    grid, keys, starts, items = nearest.build_grid(V, F, normals, reach, cell=0.006)
     tri = V[F]
     for p in rng.uniform(-0.055, 0.055, (300, 3)):
         d = np.linalg.norm(trimesh.triangles.closest_point(tri, np.repeat(p[None], len(F), 0)) - p,
                            axis=1)
-        idx = ((p - grid[0:3]) // grid[3]).astype(int)
-        key = idx[0] + int(grid[4]) * (idx[1] + int(grid[5]) * idx[2])
-        j = np.searchsorted(keys, key)
-        if len(keys) == 0:
-            listed = set(items[starts[key]:starts[key + 1]])
-        else:
-            listed = set(items[starts[j]:starts[j + 1]]) if j < len(keys) and keys[j] == key else set()
-        assert set(np.flatnonzero(d <= reach)) <= listed
+        assert set(np.flatnonzero(d <= reach).tolist()) <= _leaf_faces(boxes, nodes, order, p,
+                                                                       reach)
+
+
+def test_face_neighbours_are_the_faces_across_each_edge():
+    from meshwear.kernels import tree
+
+    m = trimesh.creation.icosphere(subdivisions=2)
+    F = np.asarray(m.faces, dtype=np.int64)
+    nb = tree.face_neighbours(F)
+    assert (nb >= 0).all()                        # closed: every edge has its other face
+    for f in range(len(F)):
+        for k in range(3):
+            edge = {F[f, k], F[f, (k + 1) % 3]}
+            assert edge <= set(F[nb[f, k]].tolist()) and nb[f, k] != f
+    open_strip = np.array([[0, 1, 2], [2, 1, 3]])
+    assert tree.face_neighbours(open_strip).tolist() == [[-1, 1, -1], [0, -1, -1]]
 
 
 # --------------------------------------------------- a mesh floor is a plane
@@ -721,3 +762,71 @@ def test_the_active_set_changes_no_result_on_a_turning_mesh_in_mesh():
     (wheel_on,), (wheel_off,) = ([p for p in r.parts if p is not None] for r in (on, off))
     assert wheel_on.depth.max() > 0.0
     np.testing.assert_allclose(wheel_on.depth, wheel_off.depth, rtol=1e-9, atol=1e-22)
+
+
+STROKE = """format = 1
+[run]
+mode = "quasi-static"
+duration = 1.0
+dt = 0.05
+frames = 0
+history = 2
+gravity = [0.0, 0.0, 0.0]
+[contact]
+stiffness_per_area = 1e13
+friction = 0.3
+margin = 1e-4
+[wear]
+law = "archard"
+coefficient = 1e-15
+[[body]]
+name = "pad"
+shape = {{ type = "box", size = [0.002, 0.002, 0.001] }}
+position = [0.0, 0.0, 0.0005]
+force = [0.0, 0.0, -5.0]
+motion = "guided"
+[body.path]
+oscillation = {{ axis = [1.0, 0.0, 0.0], amplitude = 0.001, frequency = 1.0 }}
+free_axis = [0.0, 0.0, 1.0]
+[[surface]]
+name = "flat"
+type = "mesh"
+shape = {{ type = "box", size = [0.01, 0.01, 0.002] }}
+position = [0.0, 0.0, -0.001]
+resolution = {resolution}
+wear = true
+"""
+
+
+def test_a_worn_surface_is_refined_only_where_a_body_reaches_it(tmp_path):
+    """The flat under a pad rubbed by +-1 mm is refined to the resolution
+    under the stroke and the margin around it (every face some pad vertex
+    comes within the margin of, at any instant of the cycle), not all over:
+    its sides and the rest of its top keep their triangles."""
+    from meshwear.model import build_model
+
+    path = tmp_path / "stroke.toml"
+    path.write_text(STROKE.format(resolution=5e-4))
+    model = build_model(load_scene(path))
+    flat = model.surfaces.meshes[0]
+    info = flat.refinement
+    top = np.abs(flat.vertices[:, 2] - 0.001) < 1e-12       # its own frame: top at +1 mm
+    # the top refined all over would hold (10 / 0.5 + 1)^2 = 441 vertices
+    assert info["refined_vertices"] < 0.4 * 441 and top.sum() < 0.5 * 441
+    V, F = flat.vertices, flat.faces
+    edges = np.linalg.norm(V[F] - np.roll(V[F], 1, axis=1), axis=2).max(axis=1)
+    body = model.bodies[0]
+    pose = body.initial_pose.copy()
+    tri = V[F]
+    reached = np.zeros(len(F), bool)
+    for t in np.linspace(0.0, 1.0, 201):
+        body.motion.place(pose, t)
+        x = pose[0:3] + body.reference_vertices @ reference.quaternion_matrix(pose[3:7]).T
+        x = x - [0.0, 0.0, -0.001]                            # the flat's frame
+        for p in x[x[:, 2] < 0.001 + 1e-4]:
+            d = np.linalg.norm(trimesh.triangles.closest_point(tri, np.repeat(p[None], len(F), 0))
+                               - p, axis=1)
+            reached |= d <= 1e-4
+    assert reached.sum() > 50
+    assert np.all(edges[reached] <= 5e-4 * (1 + 1e-9)), "every face a body reaches is refined"
+    assert edges[~reached].max() > 4e-3, "faces nothing reaches keep their size"

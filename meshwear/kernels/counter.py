@@ -19,8 +19,8 @@ motion : (19,) float, terms : (k, 9) float
 frozen : bool
     Its turn leaves its shape unchanged: queries use its frame without the
     turn (the velocity field keeps it).
-counter_vertices, faces, frames, corner_normals, grid, keys, starts, items
-    A mesh and its face grid (:mod:`meshwear.kernels.nearest`).
+counter_vertices, faces, frames, corner_normals, search, boxes, nodes, order, neighbours
+    A mesh, its reach and its faces' tree (:mod:`meshwear.kernels.nearest`).
 part : tuple
     Its wear (:data:`meshwear.kernels.counter_wear.PART_FIELDS`; law code -1:
     it does not wear); wear moves its faces.
@@ -36,7 +36,8 @@ from .nearest import nearest_planes_parallel, nearest_planes_serial
 MESH, CYLINDER, SPHERE = 0, 1, 2
 KINDS = {"mesh": MESH, "cylinder": CYLINDER, "sphere": SPHERE}
 SURFACE_FIELDS = ("kind", "geometry", "motion", "terms", "frozen", "counter_vertices", "faces",
-                  "frames", "corner_normals", "grid", "keys", "starts", "items", "part")
+                  "frames", "corner_normals", "search", "boxes", "nodes", "order", "neighbours",
+                  "part")
 
 #: active vertices from which the threaded kernels pay for their threads
 PARALLEL_THRESHOLD = 2048
@@ -50,7 +51,7 @@ def fill_planes(surface, t, body_vertices, pose, active, out, distance, hint, bu
     (n,) int64 (the face under it). ``buffer`` (2, 3), ``rotation`` (3, 3) and
     ``frame`` (4, 3) are scratch; they hold the surface's frame afterwards."""
     (kind, geometry, motion, terms, frozen, counter_vertices, faces, frames, corner_normals,
-     grid, keys, starts, items, part) = surface
+     search, boxes, nodes, order, neighbours, part) = surface
     surface_frame(motion, terms, t, frozen, buffer, rotation, frame)
     threads = active.shape[0] >= PARALLEL_THRESHOLD
     if kind == MESH:
@@ -64,12 +65,13 @@ def fill_planes(surface, t, body_vertices, pose, active, out, distance, hint, bu
                 steady = steady and terms[m, j] == 0.0
         if threads:
             nearest_planes_parallel(body_vertices, pose, active, rotation, frame,
-                                    counter_vertices, faces, frames, corner_normals, grid, keys,
-                                    starts, items, out, distance, hint, fixed, steady)
+                                    counter_vertices, faces, frames, corner_normals, search,
+                                    boxes, nodes, order, neighbours, out, distance, hint, fixed,
+                                    steady)
         else:
             nearest_planes_serial(body_vertices, pose, active, rotation, frame, counter_vertices,
-                                  faces, frames, corner_normals, grid, keys, starts, items, out,
-                                  distance, hint, fixed, steady)
+                                  faces, frames, corner_normals, search, boxes, nodes, order,
+                                  neighbours, out, distance, hint, fixed, steady)
     elif kind == CYLINDER:
         if threads:
             cylinder_planes_parallel(body_vertices, pose, active, rotation, frame, geometry, out,

@@ -153,7 +153,7 @@ def _wear_parts(body, surfaces, law, n_planes, t, buffer, rotation, frame, repor
     vertex_planes, hint, active = body[12], body[13], body[14]
     for m in range(len(surfaces)):
         surface = surfaces[m]
-        part = surface[13]
+        part = surface[14]
         if part[0][0] < 0.0:
             continue
         surface_frame(surface[2], surface[3], t, surface[4], buffer, rotation, frame)
@@ -202,7 +202,7 @@ def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, 
     n_planes = plane_array.shape[0]
     worn = False
     for m in range(len(surfaces)):
-        worn = worn or surfaces[m][13][0][0] >= 0.0
+        worn = worn or surfaces[m][14][0][0] >= 0.0
     rotation, frame = np.zeros((3, 3)), np.zeros((4, 3))
     placed = np.zeros(13)
     no_scale = np.zeros(0)

@@ -1,12 +1,15 @@
 """The counter face under each vertex: nearest-face queries on a mesh counter-surface.
 
 A mesh counter-surface gives each vertex of a worn body the plane of its
-nearest face (docs/model.md: then the same point-plane contact). The faces
-are binned once, in the counter-surface's own frame, into a uniform grid whose
-cells list every face within ``reach`` of any point of the cell
-(:func:`build_grid`); a query looks up the one cell holding the point, so it
-costs a few closest-point tests whatever the mesh size. Built once per
-surface: the surface moves as a rigid body, so its frame carries the grid.
+nearest face (docs/model.md: then the same point-plane contact). A vertex
+still over the face it had keeps it without a search; one that moved off it
+tries the faces across that face's edges, then searches a bounding-volume
+tree over the faces (:mod:`meshwear.kernels.tree`), in the surface's own
+frame, for the faces nearer than those, so a query costs O(log F) box tests
+and the faces near the vertex, whatever the mesh's size and however far it
+looks. Built once per surface: the surface moves as a rigid body, so its
+frame carries the tree; a worn one's boxes are grown by a slack and fitted
+anew once its wear passes it.
 
 Arrays (C-contiguous float64 unless said otherwise):
 
@@ -23,12 +26,12 @@ frames : (F, 4, 4)
 corner_normals : (F, 3, 3) or (0, 3, 3)
     Unit normals at each face's corners to interpolate over the face
     (smoothed normals, :func:`corner_normals`), or empty for the face normal.
-grid : (9,)
-    Origin (3), cell size, cells along x, y, z, reach (m), unused.
-keys : (C,) int64, starts : (C + 1,) int64, items : (E,) int64
-    Sorted keys of the non-empty cells, and the faces of cell ``j`` as
-    ``items[starts[j]:starts[j + 1]]``; ``keys`` empty for a dense grid, where
-    ``j`` is the cell's key itself.
+search : (2,)
+    The reach (m): faces farther are not found; unused.
+boxes : (N, 6), nodes : (N, 2) int64, order : (F,) int64
+    The faces' tree (:mod:`meshwear.kernels.tree`).
+neighbours : (F, 3) int64
+    The face across each edge (:func:`meshwear.kernels.tree.face_neighbours`).
 """
 
 import numpy as np
@@ -36,6 +39,11 @@ from numba import njit, prange
 
 from .contact import _named_copy, rotation_entries  # noqa: F401  (re-exported for twins)
 from .frames import to_frame
+from .tree import STACK, box_distance2, closest_on_triangle
+
+#: faces a vertex that moved off its face walks across to find the one it is
+#: over now (a step of fast sliding on a fine mesh crosses several)
+WALK = 32
 
 #: relative tolerance under which two faces count as equally near (a point
 #: beyond a shared edge or vertex); the one whose plane separates more wins
@@ -70,78 +78,61 @@ OVER = 1e-9
 
 
 @njit(cache=True, inline="always")
-def closest_on_triangle(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz):
-    """Closest point of triangle abc to p and its barycentric weights
-    (Ericson, Real-Time Collision Detection, 5.1.5): (qx, qy, qz, u, v, w)."""
-    abx, aby, abz = bx - ax, by - ay, bz - az
-    acx, acy, acz = cx - ax, cy - ay, cz - az
-    apx, apy, apz = px - ax, py - ay, pz - az
-    d1 = abx * apx + aby * apy + abz * apz
-    d2 = acx * apx + acy * apy + acz * apz
-    if d1 <= 0.0 and d2 <= 0.0:
-        return ax, ay, az, 1.0, 0.0, 0.0
-    bpx, bpy, bpz = px - bx, py - by, pz - bz
-    d3 = abx * bpx + aby * bpy + abz * bpz
-    d4 = acx * bpx + acy * bpy + acz * bpz
-    if d3 >= 0.0 and d4 <= d3:
-        return bx, by, bz, 0.0, 1.0, 0.0
-    vc = d1 * d4 - d3 * d2
-    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
-        v = d1 / (d1 - d3)
-        return ax + v * abx, ay + v * aby, az + v * abz, 1.0 - v, v, 0.0
-    cpx, cpy, cpz = px - cx, py - cy, pz - cz
-    d5 = abx * cpx + aby * cpy + abz * cpz
-    d6 = acx * cpx + acy * cpy + acz * cpz
-    if d6 >= 0.0 and d5 <= d6:
-        return cx, cy, cz, 0.0, 0.0, 1.0
-    vb = d5 * d2 - d1 * d6
-    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
-        w = d2 / (d2 - d6)
-        return ax + w * acx, ay + w * acy, az + w * acz, 1.0 - w, 0.0, w
-    va = d3 * d6 - d5 * d4
-    if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
-        w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
-        return bx + w * (cx - bx), by + w * (cy - by), bz + w * (cz - bz), 0.0, 1.0 - w, w
-    denom = 1.0 / (va + vb + vc)
-    v = vb * denom
-    w = vc * denom
-    return (ax + abx * v + acx * w, ay + aby * v + acy * w, az + abz * v + acz * w,
-            1.0 - v - w, v, w)
-
-
-@njit(cache=True, inline="always")
-def _cell_range(yx, yy, yz, grid, keys, starts):
-    """Slice of ``items`` listing the faces near counter-frame point y."""
-    h = grid[3]
-    ix = int(np.floor((yx - grid[0]) / h))
-    iy = int(np.floor((yy - grid[1]) / h))
-    iz = int(np.floor((yz - grid[2]) / h))
-    nx, ny, nz = int(grid[4]), int(grid[5]), int(grid[6])
-    if ix < 0 or iy < 0 or iz < 0 or ix >= nx or iy >= ny or iz >= nz:
-        return 0, 0
-    key = ix + nx * (iy + ny * iz)
-    if keys.shape[0] == 0:           # a dense grid: every cell has its slot
-        return starts[key], starts[key + 1]
-    j = np.searchsorted(keys, key)
-    if j >= keys.shape[0] or keys[j] != key:
-        return 0, 0
-    return starts[j], starts[j + 1]
-
-
-@njit(cache=True, inline="always")
 def _along(frames, f, row, x, y, z):
     """Signed distance of (x, y, z) past line/plane ``row`` of face ``f``'s frame."""
     return frames[f, row, 0] * x + frames[f, row, 1] * y + frames[f, row, 2] * z - frames[f, row, 3]
 
 
+@njit(cache=True)
+def _consider(f, yx, yy, yz, frames, faces, counter_vertices, reach2, over, grow, tracked,
+              tx, ty, tz, walked, best, best_d2, best_delta, kept, kept_d2, kept_delta):
+    """Face ``f`` against the nearest face so far (best) and the nearest the
+    vertex can stay on (kept, TRACKING): both, updated. ``walked``: a face
+    of the walk from the vertex's last face, which it may stay on however
+    far; the others only if no farther than the nearest face or the kept one."""
+    delta = _along(frames, f, 0, yx, yy, yz)
+    plane2 = delta * delta
+    if plane2 > reach2:
+        return best, best_d2, best_delta, kept, kept_d2, kept_delta
+    # how far the foot of y on the plane lies outside the triangle's
+    # edges: its distance to the face is at least that
+    outside = max(_along(frames, f, 1, yx, yy, yz), _along(frames, f, 2, yx, yy, yz),
+                  _along(frames, f, 3, yx, yy, yz))
+    bound = plane2 + outside * outside if outside > 0.0 else plane2
+    if bound > reach2 or (bound > best_d2 * grow
+                          and (not (tracked and (walked or kept >= 0)) or bound > kept_d2 * grow)):
+        return best, best_d2, best_delta, kept, kept_d2, kept_delta
+    if outside <= 0.0:
+        d2 = plane2        # the foot is on the face
+    else:
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        cx, cy, cz, cu, cv, cw = closest_on_triangle(
+            yx, yy, yz,
+            counter_vertices[a, 0], counter_vertices[a, 1], counter_vertices[a, 2],
+            counter_vertices[b, 0], counter_vertices[b, 1], counter_vertices[b, 2],
+            counter_vertices[c, 0], counter_vertices[c, 1], counter_vertices[c, 2])
+        d2 = (yx - cx) ** 2 + (yy - cy) ** 2 + (yz - cz) ** 2
+        if d2 > reach2:
+            return best, best_d2, best_delta, kept, kept_d2, kept_delta
+    tie = TIE * max(d2, best_d2 if best >= 0 else d2)
+    if best < 0 or d2 < best_d2 - tie or (d2 <= best_d2 + tie and delta > best_delta):
+        best, best_d2, best_delta = f, d2, delta
+    if (tracked and outside <= over
+            and _along(frames, f, 0, tx, ty, tz) + frames[f, 0, 3] >= TRACKING):
+        tie = TIE * max(d2, kept_d2 if kept >= 0 else d2)
+        if kept < 0 or d2 < kept_d2 - tie or (d2 <= kept_d2 + tie and delta > kept_delta):
+            kept, kept_d2, kept_delta = f, d2, delta
+    return best, best_d2, best_delta, kept, kept_d2, kept_delta
+
+
 def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-                    frames, corner_normals, grid, keys, starts, items, out, distance, hint,
-                    fixed, steady):
+                    frames, corner_normals, search, boxes, nodes, order, neighbours, out,
+                    distance, hint, fixed, steady):
     r = rotation_entries(pose[3:7])
     smooth = corner_normals.shape[0] > 0
     flat = not smooth
-    reach2 = grid[7] * grid[7]
-    over = OVER * grid[7]
+    reach2 = search[0] * search[0]
+    over = OVER * search[0]
     grow = 1.0 + 2.0 * TIE
     # the counter frame's origin, velocity, turn and its centre, as scalars
     # (read once, not again after each write to out)
@@ -181,13 +172,12 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
         best = kept = -1
         best_d2 = kept_d2 = np.inf
         best_delta = kept_delta = -np.inf
-        lo, hi = 0, -1
-        by_hint = False
+        by_hint = onto = False
         h = hint[i]
         if tracked and h >= 0:
             # still over the face it had, within reach and TRACKING: it stays
-            # there, no scan (the scan would pick it too, unless the vertex
-            # is over two such faces at once, at a concave fold)
+            # there, no search (the search would pick it too, unless the
+            # vertex is over two such faces at once, at a concave fold)
             delta = _along(frames, h, 0, yx, yy, yz)
             outside = max(_along(frames, h, 1, yx, yy, yz), _along(frames, h, 2, yx, yy, yz),
                           _along(frames, h, 3, yx, yy, yz))
@@ -202,42 +192,68 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
         if kept < 0:
             if tracked and fixed and flat:
                 tx, ty, tz = to_frame(rotation, ox, oy, oz)
-            lo, hi = _cell_range(yx, yy, yz, grid, keys, starts)
-        for j in range(lo, hi):
-            f = items[j]
-            delta = _along(frames, f, 0, yx, yy, yz)
-            plane2 = delta * delta
-            if plane2 > reach2:
-                continue
-            # how far the foot of y on the plane lies outside the triangle's
-            # edges: its distance to the face is at least that
-            outside = max(_along(frames, f, 1, yx, yy, yz), _along(frames, f, 2, yx, yy, yz),
-                          _along(frames, f, 3, yx, yy, yz))
-            bound = plane2 + outside * outside if outside > 0.0 else plane2
-            if bound > reach2 or (bound > best_d2 * grow
-                                  and (not tracked or bound > kept_d2 * grow)):
-                continue
-            if outside <= 0.0:
-                d2 = plane2        # the foot is on the face
-            else:
-                a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-                cx, cy, cz, cu, cv, cw = closest_on_triangle(
-                    yx, yy, yz,
-                    counter_vertices[a, 0], counter_vertices[a, 1], counter_vertices[a, 2],
-                    counter_vertices[b, 0], counter_vertices[b, 1], counter_vertices[b, 2],
-                    counter_vertices[c, 0], counter_vertices[c, 1], counter_vertices[c, 2])
-                d2 = (yx - cx) ** 2 + (yy - cy) ** 2 + (yz - cz) ** 2
-                if d2 > reach2:
-                    continue
-            tie = TIE * max(d2, best_d2 if best >= 0 else d2)
-            if best < 0 or d2 < best_d2 - tie or (d2 <= best_d2 + tie and delta > best_delta):
-                best, best_d2, best_delta = f, d2, delta
-            if (tracked and outside <= over
-                    and _along(frames, f, 0, tx, ty, tz) + frames[f, 0, 3] >= TRACKING):
-                tie = TIE * max(d2, kept_d2 if kept >= 0 else d2)
-                if kept < 0 or d2 < kept_d2 - tie or (d2 <= kept_d2 + tie and delta > kept_delta):
-                    kept, kept_d2, kept_delta = f, d2, delta
-        if (kept >= 0 and not by_hint and kept_delta < 0.0 and best >= 0
+            if tracked and h >= 0:
+                # it has moved off its face: walk across the edge its foot is
+                # farthest beyond, face by face while they keep within
+                # TRACKING, to the face it is over now (WALK faces at most)
+                f = h
+                for _ in range(WALK):
+                    best, best_d2, best_delta, kept, kept_d2, kept_delta = _consider(
+                        f, yx, yy, yz, frames, faces, counter_vertices, reach2, over, grow,
+                        tracked, tx, ty, tz, True, best, best_d2, best_delta, kept, kept_d2,
+                        kept_delta)
+                    edge, beyond = 0, _along(frames, f, 1, yx, yy, yz)
+                    for e in range(1, 3):
+                        a = _along(frames, f, e + 1, yx, yy, yz)
+                        if a > beyond:
+                            edge, beyond = e, a
+                    if beyond <= over:
+                        # over it: it stays there, as on its own face, if it
+                        # may (TRACKING, reach) and is not deep under it
+                        if (kept == f and not (kept_delta < 0.0
+                                               and -kept_delta > RELEASE * max(-beyond, 0.0))):
+                            onto = True
+                        break
+                    g = neighbours[f, edge]
+                    if g < 0 or _along(frames, g, 0, tx, ty, tz) + frames[g, 0, 3] < TRACKING:
+                        break                   # a border, or a crease it does not follow
+                    f = g
+            walked = kept >= 0
+            # the tree's nodes whose boxes come within reach and nearer than
+            # the faces found (the face the walk reached, if the vertex can
+            # stay on it), nearer child first
+            if (not onto and boxes.shape[0] > 0
+                    and box_distance2(boxes, 0, yx, yy, yz) <= reach2):
+                stack = np.empty(STACK, np.int64)
+                stack[0] = 0
+                top = 1
+                while top > 0:
+                    top -= 1
+                    node = stack[top]
+                    bound = box_distance2(boxes, node, yx, yy, yz)
+                    if bound > reach2 or (bound > best_d2 * grow
+                                          and (kept < 0 or bound > kept_d2 * grow)):
+                        continue
+                    first, count = nodes[node, 0], nodes[node, 1]
+                    if count > 0:
+                        for e in range(first, first + count):
+                            best, best_d2, best_delta, kept, kept_d2, kept_delta = _consider(
+                                order[e], yx, yy, yz, frames, faces, counter_vertices, reach2,
+                                over, grow, tracked, tx, ty, tz, False, best, best_d2,
+                                best_delta, kept, kept_d2, kept_delta)
+                        continue
+                    near = box_distance2(boxes, first, yx, yy, yz)
+                    far = box_distance2(boxes, first + 1, yx, yy, yz)
+                    if near <= far:
+                        stack[top] = first + 1
+                        stack[top + 1] = first
+                    else:
+                        stack[top] = first
+                        stack[top + 1] = first + 1
+                    top += 2
+            if kept >= 0 and not walked and kept_d2 > best_d2 * grow:
+                kept = -1               # not reached by the walk, and not the nearest
+        if (kept >= 0 and not by_hint and not onto and kept_delta < 0.0 and best >= 0
                 and kept_delta * kept_delta > RELEASE * RELEASE * best_d2):
             kept = -1                    # deep under it, near another face: let go
         if kept >= 0:
@@ -334,11 +350,11 @@ PARALLEL_THRESHOLD = 2048
 
 
 def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-                   frames, corner_normals, grid, keys, starts, items, out, distance, hint,
-                   fixed=False, steady=False):
+                   frames, corner_normals, search, boxes, nodes, order, neighbours, out, distance,
+                   hint, fixed=False, steady=False):
     """For each ``active`` vertex ``i`` of a body at ``pose``, write to
-    ``out[i]`` (3, 3) the plane of its nearest counter face within the grid's
-    reach (``grid[7]``) (a point of it, its normal, and the counter velocity at
+    ``out[i]`` (3, 3) the plane of its nearest counter face within the
+    reach (``search[0]``) (a point of it, its normal, and the counter velocity at
     the vertex's foot on it; world), to
     ``distance[i]`` the distance to that face and to ``hint[i]`` (int64) the
     face's index; zeros, ``inf`` and -1 where no face qualifies. A vertex that
@@ -355,8 +371,8 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
     kernel = (nearest_planes_parallel if active.shape[0] >= PARALLEL_THRESHOLD
               else nearest_planes_serial)
     kernel(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
-           frames, corner_normals, grid, keys, starts, items, out, distance, hint, fixed,
-           steady)
+           frames, corner_normals, search, boxes, nodes, order, neighbours, out, distance,
+           hint, fixed, steady)
 
 
 #: faces meeting at a vertex at more than 60 degrees are a crease: smoothed
@@ -392,94 +408,3 @@ def corner_normals(vertices, faces, normals):
     np.add.at(out, pair_corner[keep], (angle[other_corner][:, None] * normals[other])[keep])
     out /= np.linalg.norm(out, axis=1)[:, None]
     return np.ascontiguousarray(out.reshape(len(faces), 3, 3))
-
-
-#: grids of at most this many cells keep a slot per cell (8 bytes each); larger
-#: ones list their non-empty cells and search them
-DENSE_CELLS = 4_000_000
-
-#: largest number of (cell, face) entries a grid may hold; the cells grow past it
-MAX_ENTRIES = 5_000_000
-
-
-def build_grid(vertices, faces, normals, reach, cell=None):
-    """Bin the faces of a counter mesh: every cell lists each face that has a
-    point within ``reach`` of some point of the cell.
-
-    Parameters
-    ----------
-    vertices, faces, normals : the counter mesh in its frame
-    reach : float
-        m; queries find every face within it.
-    cell : float, optional
-        Cell size (m). By default the size, among a few around the median
-        edge length (and at least the reach), whose cells list the fewest faces
-        where faces are (the expected faces per query), within
-        :data:`MAX_ENTRIES`.
-
-    Returns
-    -------
-    grid, keys, starts, items : the arrays :func:`nearest_planes` takes.
-    """
-    tri = vertices[faces]
-    lo = vertices.min(axis=0) - reach - 1e-9
-    span = vertices.max(axis=0) + reach + 1e-9 - lo
-    if cell:
-        sizes = [float(cell)]
-    else:
-        edges = np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2)
-        base = max(reach, float(np.median(edges)))
-        sizes = [base * f for f in (0.5, 0.75, 1.0, 1.5, 2.0, 3.0)]
-    best = None
-    for h in sizes:
-        binned = _bin(tri, normals, lo, span, reach, h)
-        if binned is None:
-            continue
-        key = binned[1]
-        per_cell = np.unique(key, return_counts=True)[1]
-        score = float((per_cell ** 2).sum() / max(per_cell.sum(), 1))
-        if best is None or score < best[0]:
-            best = (score, binned)
-    h = sizes[-1]
-    while best is None:               # every size too fine for MAX_ENTRIES: grow
-        h *= 1.5
-        binned = _bin(tri, normals, lo, span, reach, h)
-        if binned is not None:
-            best = (0.0, binned)
-    h, key, face_of, dims = best[1]
-    grid = np.array([lo[0], lo[1], lo[2], h, dims[0], dims[1], dims[2], reach, 0.0])
-    cells = int(np.prod(dims))
-    if cells <= DENSE_CELLS:
-        # a slot per cell: a lookup is one index, no search
-        starts = np.searchsorted(key, np.arange(cells + 1)).astype(np.int64)
-        return grid, np.zeros(0, dtype=np.int64), starts, face_of.astype(np.int64)
-    keys, first_index = np.unique(key, return_index=True)
-    starts = np.append(first_index, len(key)).astype(np.int64)
-    return grid, keys.astype(np.int64), starts, face_of.astype(np.int64)
-
-
-def _bin(tri, normals, lo, span, reach, h):
-    """(h, sorted cell keys, their faces, dims) of a grid of cell size ``h``,
-    or None if it would hold more than :data:`MAX_ENTRIES` entries."""
-    dims = np.maximum(1, np.ceil(span / h)).astype(np.int64)
-    first = np.floor((tri.min(axis=1) - reach - lo) / h).astype(np.int64)
-    last = np.floor((tri.max(axis=1) + reach - lo) / h).astype(np.int64)
-    first, last = np.clip(first, 0, dims - 1), np.clip(last, 0, dims - 1)
-    counts = np.prod(last - first + 1, axis=1)
-    if counts.sum() > MAX_ENTRIES:
-        return None
-    # every cell of each face's box, kept where the face's plane passes within
-    # reach of the cell (a long slanted CAD triangle spans a thin slab of its box)
-    face_of = np.repeat(np.arange(len(tri)), counts)
-    offset = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-    size = (last - first + 1)[face_of]
-    ix = first[face_of, 0] + offset % size[:, 0]
-    iy = first[face_of, 1] + (offset // size[:, 0]) % size[:, 1]
-    iz = first[face_of, 2] + offset // (size[:, 0] * size[:, 1])
-    centre = lo + (np.stack([ix, iy, iz], axis=1) + 0.5) * h
-    plane_gap = np.abs(np.einsum("ij,ij->i", centre - tri[face_of, 0], normals[face_of]))
-    keep = plane_gap <= reach + 0.5 * np.sqrt(3.0) * h
-    key = (ix + dims[0] * (iy + dims[1] * iz))[keep]
-    face_of = face_of[keep]
-    order = np.lexsort((face_of, key))
-    return h, key[order], face_of[order], dims

@@ -35,9 +35,8 @@ MARGIN_FRACTION = 0.01
 #: step, so a vertex always meets a surface within reach before it touches
 STEPS_IN_MARGIN = 10.0
 #: the steps' queries look this fraction of the active set's margin away
-#: (:func:`query_reach`): the cells of a mesh's grid list the faces within
-#: the reach, so a query's cost grows with it (the refresh's own look goes
-#: the whole margin, on a grid of its own)
+#: (:func:`query_reach`): a vertex with no face within the reach has no
+#: plane (the refresh's own look goes the whole margin)
 QUERY_FRACTION = 0.3
 
 #: slots of :attr:`meshwear.model.BodyState.cull`
@@ -102,7 +101,7 @@ class SurfaceSet:
 
     def compiled_list(self):
         """The per-vertex surfaces' tuples as the numba typed list the
-        compiled loop takes (rebuilt when one changed: a face grid rebinned)."""
+        compiled loop takes (rebuilt when one changed: a face tree built)."""
         tuples = [s.compiled() for s in self.per_vertex]
         # the tuples themselves are kept (not their ids: a freed tuple's id
         # can come back for the next one, a worn surface attached anew)
@@ -265,7 +264,7 @@ def refresh(model, body, s, t):
         # less worn parts under a vertex: nearer by at most its deepest wear
         reach = margin + (float(surface.part.depth.max()) if surface.worn else 0.0)
         if surface.worn:
-            surface.rebin()     # if its wear since the last binning passed the grid's slack
+            surface.rebin()     # if its wear since its boxes were fitted passed their slack
         candidates = surface.candidates(surfaces, body, s.pose, x, t, reach)
         if not len(candidates):
             continue

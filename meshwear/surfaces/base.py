@@ -211,14 +211,15 @@ class CounterSurface:
         if self._compiled is None:
             g = {"counter_vertices": np.zeros((0, 3)), "faces": np.zeros((0, 3), np.int64),
                  "frames": np.zeros((0, 4, 4)), "corner_normals": np.zeros((0, 3, 3)),
-                 "grid": np.zeros(9), "keys": np.zeros(0, np.int64),
-                 "starts": np.zeros(1, np.int64), "items": np.zeros(0, np.int64)}
+                 "search": np.zeros(2), "boxes": np.zeros((0, 6)),
+                 "nodes": np.zeros((0, 2), np.int64), "order": np.zeros(0, np.int64),
+                 "neighbours": np.zeros((0, 3), np.int64)}
             g.update(self.geometry())
             self._compiled = (np.int64(self.kind), np.ascontiguousarray(g["geometry"], float),
                               self.motion.array, np.ascontiguousarray(self.motion.terms),
                               bool(self.frozen), g["counter_vertices"], g["faces"], g["frames"],
-                              g["corner_normals"], g["grid"], g["keys"], g["starts"], g["items"],
-                              self.part_tuple())
+                              g["corner_normals"], g["search"], g["boxes"], g["nodes"],
+                              g["order"], g["neighbours"], self.part_tuple())
         return self._compiled
 
     def fill(self, body_vertices, pose, active, out, distance, hint, t):
@@ -250,7 +251,7 @@ class CounterSurface:
 
     def fill_within(self, reach, body_vertices, pose, active, out, distance, hint, t):
         """:meth:`fill` finding the surface up to ``reach`` (m) away (the
-        active set's refresh; meshes keep a grid for it)."""
+        active set's refresh)."""
         self.ensure_reach(reach)
         self.fill(body_vertices, pose, active, out, distance, hint, t)
 

@@ -1,4 +1,4 @@
-"""Mesh counter-surfaces: a rigid triangle mesh, its face grid and its fcl BVH.
+"""Mesh counter-surfaces: a rigid triangle mesh, its face tree and its fcl BVH.
 
 Each vertex of a worn body gets the plane of its nearest counter face
 (:mod:`meshwear.kernels.nearest`). A mesh turning about an axis that it is a
@@ -13,7 +13,8 @@ import numpy as np
 from .. import geometry, remesh
 from ..kernels.counter import MESH
 from ..kernels.laws import name_of as code_name
-from ..kernels.nearest import (build_grid, corner_normals, face_frames, nearest_planes_parallel,
+from ..kernels import tree
+from ..kernels.nearest import (corner_normals, face_frames, nearest_planes_parallel,
                                nearest_planes_serial)
 from .base import CounterSurface, SurfaceMotion, axis_rotation, quaternion_matrix
 
@@ -26,10 +27,13 @@ INVARIANT_FRACTION = 0.25
 SAMPLE_TURNS = (0.145898, 0.381966, 0.618034, 0.854102)
 #: the deviation is sampled at most at this many points (vertices, face centres)
 MAX_SAMPLES = 200_000
-#: a worn mesh bins its faces this fraction of the reach farther than its
-#: queries cut at, so its wear (a vertex sinking along its normal) needs no
-#: new binning until some vertex has sunk that far since the last one
+#: a worn mesh grows its face tree's boxes by this fraction of the steps'
+#: reach on the side its vertices sink to (not towards the bodies: their
+#: queries keep tight bounds), so its wear needs no new fit until some
+#: vertex has sunk that far since the last one
 WEAR_SLACK = 0.1
+#: an unworn mesh grows its boxes by this fraction of its size (rounding)
+ROUNDING = 1e-9
 
 
 def bvh(vertices, faces):
@@ -64,13 +68,21 @@ class MeshSurface(CounterSurface):
         world = self.vertices @ m.R0.T + m.position - m.center
         #: largest distance of a mesh point from the turn's axis (m)
         self.lever = float(np.linalg.norm(world - np.outer(world @ m.axis, m.axis), axis=1).max())
+        #: how far (m) the steps' queries look, and the array the compiled
+        #: tuple reads it from (the refresh and the placing checks look
+        #: farther through it)
         self.reach = 0.0
-        self.grid = None
-        #: a worn one's wear depth where its faces were last binned (None: not yet)
-        self.binned_depth = None
-        #: [reach, grid, binned depth, compiled tuple] of the active set's
-        #: refresh when it looks farther than the steps' queries (None: not yet)
-        self.far = None
+        self.search = np.zeros(2)
+        #: (boxes, nodes, order) of the faces (:mod:`meshwear.kernels.tree`)
+        #: and the face across each edge
+        self.tree = None
+        self.neighbours = tree.face_neighbours(self.faces)
+        #: what ``resolution`` did (:func:`meshwear.remesh.refine_part`), or None
+        self.refinement = None
+        #: a worn one's boxes' slack (m) and its wear depth when they were
+        #: last fitted
+        self.pad = 0.0
+        self.fitted_depth = None
         #: the :class:`meshwear.model.PartState` a worn one queries and draws
         self.part = None
         self.bvh_geometry = bvh(self.vertices, self.faces)
@@ -86,10 +98,24 @@ class MeshSurface(CounterSurface):
             For a mesh the engine cannot use; the caller adds the key.
         """
         vertices, faces = geometry.load_part(config)
-        if config.resolution is not None:
-            vertices, faces = remesh.refine(vertices, faces, config.resolution)
         return cls(config.name, vertices, faces, config.position, config.orientation,
                    config.rotation, config.path, config.smooth_normals)
+
+    def refined(self, config, face_mask=None):
+        """A :class:`MeshSurface` of this mesh refined to ``config.resolution``
+        where ``face_mask`` says (:func:`meshwear.remesh.refine_part`);
+        built before it wears.
+
+        Raises
+        ------
+        geometry.MeshError
+            For a refinement the machine cannot hold; the caller adds the key.
+        """
+        vertices, faces, info = remesh.refine_part(config, self.vertices, self.faces, face_mask)
+        out = type(self)(config.name, vertices, faces, config.position, config.orientation,
+                         config.rotation, config.path, config.smooth_normals)
+        out.refinement = info
+        return out
 
     # ------------------------------------------------------------ shape invariance
     def settle_invariance(self, margin):
@@ -118,7 +144,8 @@ class MeshSurface(CounterSurface):
         if len(samples) > MAX_SAMPLES:
             pick = np.random.default_rng(0).choice(len(samples), MAX_SAMPLES, replace=False)
             samples = samples[np.sort(pick)]
-        grid, keys, starts, items = build_grid(self.vertices, self.faces, self.face_normals, limit)
+        boxes, nodes, order = self._tree()
+        search = np.array([limit, 0.0])
         n = len(samples)
         identity = np.zeros(13)
         identity[3] = 1.0
@@ -130,8 +157,8 @@ class MeshSurface(CounterSurface):
             turned = np.ascontiguousarray((samples - center) @ turn_matrix.T + center)
             out, distance = np.zeros((n, 3, 3)), np.full(n, np.inf)
             kernel(turned, identity, active, np.eye(3), np.zeros((4, 3)), self.vertices,
-                   self.faces, self.frames, self.corner_normals, grid, keys, starts, items, out,
-                   distance, np.full(n, -1), True, False)
+                   self.faces, self.frames, self.corner_normals, search, boxes, nodes, order,
+                   self.neighbours, out, distance, np.full(n, -1), True, False)
             worst = max(worst, float(distance.max()))
             if not worst <= limit:
                 return np.inf
@@ -166,8 +193,8 @@ class MeshSurface(CounterSurface):
         :class:`meshwear.model.PartState`): its vertices and face frames."""
         self.vertices, self.frames, self.part = part.vertices, part.frames, part
         self._compiled = None
-        if self.far is not None:
-            self.far[3] = None                    # its tuple holds the arrays too
+        if self.tree is not None:
+            self._fit()
 
     def face_weights(self, points, face, t):
         """Barycentric weights (k, 3) of world ``points`` (k, 3) at ``t`` on
@@ -188,32 +215,48 @@ class MeshSurface(CounterSurface):
         return weights, corners
 
     def rebin(self):
-        """Bin the faces anew where they are now (a worn part after a jump or
-        a restart) if some vertex has sunk farther than a grid's slack
-        (:data:`WEAR_SLACK` of its reach) since they were binned for it. Binning the gear pair's wheel (18 600 faces, a 3.3 mm
-        reach) took 1.5-2 s a jump; its wear over 10^5 revolutions is a few µm."""
-        if self.grid is not None and self._sunk(self.binned_depth, self.reach):
-            self.grid, self.binned_depth = self._bin(self.reach)
+        """Fit the tree's boxes anew where the faces are now (a worn part
+        after a jump or a restart) if some vertex has sunk farther than
+        their slack since they were fitted (O(F), in place)."""
+        if (self.tree is not None and self.part is not None and self.fitted_depth is not None
+                and float(np.abs(self.part.depth - self.fitted_depth).max(initial=0.0))
+                > self.pad):
+            self._fit()
+
+    def _tree(self):
+        """The faces' tree, built at the first need."""
+        if self.tree is None:
+            self.tree = tree.build(self.vertices, self.faces, *self._growth())
+            self.fitted_depth = self._depth()
             self._compiled = None
-        if self.far is not None and self._sunk(self.far[2], self.far[0]):
-            self.far = None                   # binned anew when next asked for
+        return self.tree
 
-    def _sunk(self, binned_depth, reach):
-        """Whether a worn one has sunk past the slack of a grid binned at ``binned_depth``."""
-        return (self.part is not None and binned_depth is not None and float(
-            np.abs(self.part.depth - binned_depth).max(initial=0.0)) > WEAR_SLACK * reach)
-
-    def _bin(self, reach):
-        """A face grid whose cells list every face within ``reach`` (and the
-        wear slack, for a worn one) of their points, queries cutting at
-        ``reach``; and the wear depth it was binned at (None: it does not wear)."""
+    def _growth(self):
+        """How far (m) the boxes reach past the faces: rounding all round,
+        and for a worn one the slack (:data:`WEAR_SLACK` of the reach) along
+        its vertices' inward normals, and those normals."""
+        size = float(np.ptp(self.vertices, axis=0).max()) if len(self.vertices) else 0.0
         if not self.worn:
-            return build_grid(self.vertices, self.faces, self.face_normals, reach), None
-        grid = build_grid(self.vertices, self.faces, self.face_normals,
-                          (1.0 + WEAR_SLACK) * reach)
-        grid[0][7] = reach
-        depth = self.part.depth.copy() if self.part is not None else np.zeros(len(self.vertices))
-        return grid, depth
+            self.pad = 0.0
+            return ROUNDING * size, 0.0, None
+        self.pad = WEAR_SLACK * self.reach
+        return ROUNDING * size, self.pad, self.vertex_normals
+
+    def _depth(self):
+        """A worn one's wear depth now (a copy), None for the others."""
+        if not self.worn:
+            return None
+        return (self.part.depth.copy() if self.part is not None
+                else np.zeros(len(self.vertices)))
+
+    def _fit(self):
+        """Fit the boxes to the faces where they are now (in place: the
+        compiled tuple holds them)."""
+        boxes, nodes, order = self.tree
+        rounding, slack, sink = self._growth()
+        tree.refit(self.vertices, self.faces, nodes, order, rounding, slack,
+                   np.zeros((0, 3)) if sink is None else sink, boxes)
+        self.fitted_depth = self._depth()
 
     def part_tuple(self):
         """The ``part`` tuple of :func:`meshwear.kernels.counter_wear.wear_counter`."""
@@ -227,39 +270,40 @@ class MeshSurface(CounterSurface):
 
     # ------------------------------------------------------------ the interface
     def ensure_reach(self, reach):
-        """(Re)bin the faces if the per-step queries must find faces ``reach`` (m) away."""
+        """Make the per-step queries find faces ``reach`` (m) away: the reach
+        grows by half again when it must grow (a worn one's boxes then get
+        the slack of that reach)."""
         if reach > self.reach:
             self.reach = 1.5 * reach
-            self.grid, self.binned_depth = self._bin(self.reach)
-            self._compiled = None
+            self.search[0] = self.reach
+            if self.tree is None:
+                self._tree()
+            elif self.worn:
+                self._fit()
 
     def fill_within(self, reach, body_vertices, pose, active, out, distance, hint, t):
-        """:meth:`fill` finding faces up to ``reach`` (m) away, on a grid of
-        its own if that is farther than the per-step queries look: the
-        active set's refresh looks ten steps' motion away, the steps' own
-        queries a few (their cells list the faces within that reach: the
-        gear pair's wheel ~800 a cell at the refresh's 3.3 mm)."""
-        if reach <= self.reach:
-            self.fill(body_vertices, pose, active, out, distance, hint, t)
-            return
-        if self.far is None or reach > self.far[0]:
-            far_reach = 1.5 * reach
-            self.far = [far_reach, *self._bin(far_reach), None]
-        near = self.grid, self.reach, self._compiled
-        self.reach, self.grid, _, self._compiled = self.far
+        """:meth:`fill` finding faces up to ``reach`` (m) away (the active
+        set's refresh looks ten steps' motion away, the steps' own queries a
+        few): the tree's search goes as far as asked."""
+        self._looking(max(reach, self.reach), self.fill, body_vertices, pose, active, out,
+                      distance, hint, t)
+
+    def _looking(self, reach, call, *args):
+        """``call(*args)`` with the queries reaching ``reach`` (m)."""
+        self._tree()
+        saved = self.search[0]
+        self.search[0] = reach
         try:
-            self.fill(body_vertices, pose, active, out, distance, hint, t)
+            return call(*args)
         finally:
-            self.far[3] = self._compiled
-            self.grid, self.reach, self._compiled = near
+            self.search[0] = saved
 
     def geometry(self):
-        if self.grid is None:
-            raise RuntimeError(f"mesh surface {self.name!r}: no face grid yet (ensure_reach)")
-        grid, keys, starts, items = self.grid
+        boxes, nodes, order = self._tree()
         return {"geometry": np.zeros(3), "counter_vertices": self.vertices, "faces": self.faces,
-                "frames": self.frames, "corner_normals": self.corner_normals, "grid": grid,
-                "keys": keys, "starts": starts, "items": items}
+                "frames": self.frames, "corner_normals": self.corner_normals,
+                "search": self.search, "boxes": boxes, "nodes": nodes, "order": order,
+                "neighbours": self.neighbours}
 
     def bounds(self):
         if self.invariant:
@@ -268,13 +312,7 @@ class MeshSurface(CounterSurface):
         return self._bounds(lever=self.lever)
 
     def planes_at(self, body_vertices, pose, t, reach):
-        saved = self.grid, self.reach, self._compiled
-        self.grid, self._compiled = build_grid(self.vertices, self.faces, self.face_normals,
-                                               reach), None
-        try:
-            return super().planes_at(body_vertices, pose, t, reach)
-        finally:
-            self.grid, self.reach, self._compiled = saved
+        return self._looking(reach, super().planes_at, body_vertices, pose, t, reach)
 
     def candidates(self, surface_set, body, pose, x, t, margin):
         """The vertices inside its bounding box grown by ``margin``, if the
@@ -283,7 +321,8 @@ class MeshSurface(CounterSurface):
             return np.zeros(0, dtype=np.int64)
         rotation, frame = self.frame(t)
         y = (x - frame[0]) @ rotation
-        lo, hi = self.vertices.min(axis=0) - margin, self.vertices.max(axis=0) + margin
+        box = self._tree()[0][0]          # the root's: every face, worn ones too
+        lo, hi = box[0:3] - margin, box[3:6] + margin
         return np.flatnonzero(np.all((y >= lo) & (y <= hi), axis=1))
 
     def transform(self, t):
