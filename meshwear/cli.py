@@ -7,6 +7,7 @@ sweep with failed runs.
 
 import argparse
 import logging
+import math
 import sys
 import time
 from pathlib import Path
@@ -80,6 +81,9 @@ def main(argv=None):
     p.add_argument("--profile", metavar="X0,Y0,Z0:X1,Y1,Z1", default=None,
                    help="wear profile under the line between two points (m, the part's own "
                         "frame), as PNG and CSV; write --profile=... if it starts with '-'")
+    p.add_argument("--view", metavar="X,Y,Z", default=None,
+                   help="direction the wear maps look from (the part's own frame; default: "
+                        "onto the worn faces, or along the axis they face round, as a gear's)")
     p.add_argument("-d", "--dest", default=None,
                    help="folder for the files (default: OUT/plots)")
     p = sub.add_parser("info", help="describe a mesh file")
@@ -414,7 +418,16 @@ def _plot(args):
             raise bad from None
         if len(line) != 2 or any(len(point) != 3 for point in line):
             raise bad
-    for path in plot(args.out, args.part, args.dest, line):
+    view = None
+    if args.view is not None:
+        bad = InputError(f"--view {args.view}: expected a direction x,y,z, not zero")
+        try:
+            view = [float(v) for v in args.view.split(",")]
+        except ValueError:
+            raise bad from None
+        if len(view) != 3 or not all(math.isfinite(v) for v in view) or not any(view):
+            raise bad
+    for path in plot(args.out, args.part, args.dest, line, view):
         print(path)
     return EXIT_OK
 

@@ -256,6 +256,24 @@ def test_cycle_jumps_carry_both_parts_wear(ten_turns, measured):
                         tolerance) <= tolerance
 
 
+def test_every_history_row_of_a_jumped_run_has_both_parts_forces_balance(tmp_path):
+    """Rows filled from a jump carry the resolved cycle's contact at the same
+    phase for the worn disc too: in every row, resolved or filled, the pin's
+    contact force and the disc's sum to zero (they alternated between the
+    pin's reaction and zero where a filled row was not also a frame)."""
+    import meshwear
+
+    scene = meshwear.load(_jumped(tmp_path, 10), {"run.history": 97, "run.frames": 7})
+    result = meshwear.run(scene)
+    pin, disc = result.parts["pin"].history, result.parts["disc"].history
+    assert len(pin["fz"]) == len(disc["fz"]) == 97
+    filled = pin["resolved"] == 0
+    assert filled.sum() > 30 and (disc["resolved"] == pin["resolved"]).all()
+    assert np.all(pin["fz"][1:] > 0.5 * P)         # pressed all along (t = 0: not yet)
+    for axis in ("fx", "fy", "fz"):
+        assert np.abs(pin[axis] + disc[axis]).max() <= 1e-6 * P
+
+
 def test_a_checkpoint_inside_a_jumped_run_resumes_it(tmp_path):
     """A jumped run saved after a jump and resumed ends where the whole run
     does: the counter-part's wear and the jump controller's memory of it

@@ -6,9 +6,11 @@ body is recorded at the phases of the outputs the jump may cover
 (:func:`record`); once the jump is taken, each such output is written
 (:func:`write`) from a view of the state: wear depth, worn volume, friction
 work and the worn vertices interpolated along the jump, the pose and the
-contact forces those of the resolved cycle at the same phase (the pose put
-on its path at the output's time, a guided body moved along its axis by the
-jump's share). The rows and frames are marked ``resolved = 0``.
+contact those of the resolved cycle at the same phase (the pose put on its
+path at the output's time, a guided body moved along its axis by the jump's
+share; the forces, planes and faces of the touching vertices, so a worn
+counter-part's reaction is the bodies' at that phase too). The rows and
+frames are marked ``resolved = 0``.
 """
 
 import copy
@@ -22,26 +24,29 @@ from ..kernels.contact import FORCE
 @dataclass
 class Snapshot:
     """One body's state at one phase of the resolved cycle: pose, contact
-    wrench, contact states and, for frames, the forces and the surfaces'
-    normals under the vertices (for the pressure)."""
+    wrench, contact states, and the contact of its vertices that touch (their
+    indices, forces, the planes and faces of the per-vertex surfaces under
+    them): what the body's and the worn counter-parts' fields and reactions
+    are made of."""
 
     pose: np.ndarray
     wrench: np.ndarray
     contact_state: np.ndarray
-    normal_force: np.ndarray = None
-    friction_force: np.ndarray = None
-    normals: np.ndarray = None
+    touching: np.ndarray
+    normal_force: np.ndarray
+    friction_force: np.ndarray
+    planes: np.ndarray
+    hint: np.ndarray
 
 
-def _capture(state, frame):
+def _capture(state):
     out = []
     for s in state.bodies:
-        shot = Snapshot(s.pose.copy(), s.wrench.copy(), s.contact_state.copy())
-        if frame:
-            shot.normal_force = s.normal_force.copy()
-            shot.friction_force = s.tangential[:, :, FORCE].copy()
-            shot.normals = s.vertex_planes[:, :, 1].copy()
-        out.append(shot)
+        touching = np.flatnonzero((s.normal_force > 0.0).any(axis=0))
+        out.append(Snapshot(s.pose.copy(), s.wrench.copy(), s.contact_state.copy(), touching,
+                            s.normal_force[:, touching].copy(),
+                            s.tangential[:, touching, FORCE].copy(),
+                            s.vertex_planes[:, touching].copy(), s.hint[:, touching].copy()))
     return out
 
 
@@ -70,7 +75,7 @@ def record(model, state, start, stop, cycles, observers, progress, advance):
     for r in sorted(wanted) + [stop]:
         advance(model, state, r, observers, progress)
         if r in wanted:
-            snapshots[r - start] = _capture(state, wanted[r])
+            snapshots[r - start] = _capture(state)
     return snapshots
 
 
@@ -131,13 +136,13 @@ def _view(body, s, shot, span, fraction, t):
         if name != "shift":
             first, last = value
             setattr(view, name, first + fraction * (last - first))
-    if shot.normal_force is not None:
-        view.normal_force = shot.normal_force
-        view.tangential = np.zeros_like(s.tangential)
-        view.tangential[:, :, FORCE] = shot.friction_force
-        view.vertex_planes = np.zeros_like(s.vertex_planes)
-        view.vertex_planes[:, :, 1] = shot.normals
-    else:
-        view.normal_force = np.zeros_like(s.normal_force)
-        view.tangential = np.zeros_like(s.tangential)
+    touching = shot.touching
+    view.normal_force = np.zeros_like(s.normal_force)
+    view.normal_force[:, touching] = shot.normal_force
+    view.tangential = np.zeros_like(s.tangential)
+    view.tangential[:, touching, FORCE] = shot.friction_force
+    view.vertex_planes = np.zeros_like(s.vertex_planes)
+    view.vertex_planes[:, touching] = shot.planes
+    view.hint = np.full_like(s.hint, -1)
+    view.hint[:, touching] = shot.hint
     return view

@@ -33,7 +33,7 @@ def _pyplot():
     return plt
 
 
-def plot(out_dir, names=None, dest=None, profile=None):
+def plot(out_dir, names=None, dest=None, profile=None, view=None):
     """Write the pictures of the run in ``out_dir``; return the paths written.
 
     Parameters
@@ -45,6 +45,9 @@ def plot(out_dir, names=None, dest=None, profile=None):
     profile : ((3,), (3,)), optional
         Two points of a line in the part's own frame (m): the wear depth
         under it is written as ``<part>_profile.png`` and ``.csv``.
+    view : (3,), optional
+        Direction the wear maps look from, in the part's own frame
+        (default: :func:`map_view`).
     """
     plt = _pyplot()
     out_dir = Path(out_dir)
@@ -68,7 +71,7 @@ def plot(out_dir, names=None, dest=None, profile=None):
     dest.mkdir(parents=True, exist_ok=True)
     written = []
     for name in names:
-        written.append(wear_map(out_dir, name, dest / f"{name}_wear_map.png"))
+        written.append(wear_map(out_dir, name, dest / f"{name}_wear_map.png", view))
         if profile is not None:
             written += wear_profile(out_dir, name, profile, dest / f"{name}_profile", plt)
     history = out_dir / "history.csv"
@@ -84,10 +87,30 @@ def _mesh_fields(out_dir, name, frame=-1):
     return vertices, faces, depth, time
 
 
-def wear_map(out_dir, name, path):
+#: the worn faces face one way when the wear-weighted mean of their normals
+#: is at least this fraction of the weights (a pin, a block); else they face
+#: round an axis (a gear's flanks, a bore) and the map looks along it
+ONE_WAY = 0.3
+
+
+def map_view(normals, depth):
+    """(3,) unit direction a wear map looks from: the wear-weighted mean of the
+    outward ``normals`` of the vertices (worn by ``depth``) where the worn faces
+    face one way (:data:`ONE_WAY`); else the axis they face round (the
+    direction least along them: the weighted normals' smallest principal
+    axis), from its positive side."""
+    weights = depth / depth.max() if depth.max() > 0.0 else np.ones(len(depth))
+    mean = (weights[:, None] * normals).sum(axis=0)
+    if np.linalg.norm(mean) >= ONE_WAY * weights.sum() and np.linalg.norm(mean) > 0.0:
+        return mean / np.linalg.norm(mean)
+    spread = np.einsum("i,ij,ik->jk", weights, normals, normals)
+    axis = np.linalg.eigh(spread)[1][:, 0]
+    return axis if axis[np.argmax(np.abs(axis))] > 0.0 else -axis
+
+
+def wear_map(out_dir, name, path, view=None):
     """The part at its last frame coloured by wear depth (µm), seen from
-    outside its worn face (along the wear-weighted mean of the outward
-    normals of its worn vertices), with a scale bar."""
+    ``view`` (its own frame) or from :func:`map_view`, with a scale bar."""
     if "DISPLAY" not in os.environ and "VTK_DEFAULT_OPENGL_WINDOW" not in os.environ:
         # no X server: render through EGL (VTK's default would try X first
         # and print a warning)
@@ -99,11 +122,9 @@ def wear_map(out_dir, name, path):
     mesh.point_data["wear depth (µm)"] = depth * 1e6
     normals = mesh.compute_normals(point_normals=True, cell_normals=False,
                                    auto_orient_normals=False).point_data["Normals"]
-    weights = depth / depth.max() if depth.max() > 0.0 else np.ones(len(depth))
-    view = (weights[:, None] * normals).sum(axis=0)
-    if not np.linalg.norm(view) > 0.0:
-        view = np.array([0.0, 0.0, 1.0])
-    view /= np.linalg.norm(view)
+    view = (np.asarray(view, float) if view is not None
+            else map_view(np.asarray(normals, float), depth))
+    view = view / np.linalg.norm(view)
     up = np.cross(view, [0.0, 0.0, 1.0] if abs(view[2]) < 0.9 else [1.0, 0.0, 0.0])
     up = np.cross(up, view)
     try:
