@@ -172,11 +172,21 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
         j = touched[c]
         if worst < 0 and added[j] > SPACING_FRACTION * spacing[j]:
             worst = j
-        added[j] = 0.0
         for col in range(3):
             vertices[j, col] = reference[j, col] - depth[j] * normals[j, col]
+    # the faces round the moved vertices, each once: by its first moved
+    # corner (a face under a patch has all three moved)
     for c in range(count):
         j = touched[c]
         for e in range(starts[j], starts[j + 1]):
-            _face_frame(vertices, faces, items[e], frames)
+            face = items[e]
+            first = j
+            for corner in range(3):
+                k = faces[face, corner]
+                if added[k] != 0.0 and k < first:
+                    first = k
+            if first == j:
+                _face_frame(vertices, faces, face, frames)
+    for c in range(count):
+        added[touched[c]] = 0.0
     return worst

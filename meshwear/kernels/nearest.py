@@ -198,10 +198,6 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
                 # TRACKING, to the face it is over now (WALK faces at most)
                 f = h
                 for _ in range(WALK):
-                    best, best_d2, best_delta, kept, kept_d2, kept_delta = _consider(
-                        f, yx, yy, yz, frames, faces, counter_vertices, reach2, over, grow,
-                        tracked, tx, ty, tz, True, best, best_d2, best_delta, kept, kept_d2,
-                        kept_delta)
                     edge, beyond = 0, _along(frames, f, 1, yx, yy, yz)
                     for e in range(1, 3):
                         a = _along(frames, f, e + 1, yx, yy, yz)
@@ -210,6 +206,10 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
                     if beyond <= over:
                         # over it: it stays there, as on its own face, if it
                         # may (TRACKING, reach) and is not deep under it
+                        best, best_d2, best_delta, kept, kept_d2, kept_delta = _consider(
+                            f, yx, yy, yz, frames, faces, counter_vertices, reach2, over, grow,
+                            tracked, tx, ty, tz, True, best, best_d2, best_delta, kept, kept_d2,
+                            kept_delta)
                         if (kept == f and not (kept_delta < 0.0
                                                and -kept_delta > RELEASE * max(-beyond, 0.0))):
                             onto = True
