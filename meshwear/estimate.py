@@ -15,8 +15,9 @@ import numpy as np
 from . import stepper
 from .model import initial_state
 
-#: steps timed for the per-step cost
-TRIAL_STEPS = 200
+#: steps timed for the per-step cost at most, and the wall time (s) after
+#: which the trial stops sooner (steps of seconds: a fine worn mesh)
+TRIAL_STEPS, TRIAL_SECONDS = 200, 2.0
 #: wall time (s) a cycle-jumping run is tried for, and longer, up to
 #: JUMP_TRIAL_LONGEST, until bounds other than growth have set BOUNDED_JUMPS
 #: jumps (what the rest of the run's jumps are extrapolated from)
@@ -57,9 +58,16 @@ def estimate_run(model):
     stepper.advance(model, state, warm)  # compile (or load the cached) kernels, as the run does
     load = time.perf_counter() - start
     trial = min(model.n_steps - warm, TRIAL_STEPS)
+    done, chunk = 0, 1
     start = time.perf_counter()
-    stepper.advance(model, state, warm + trial)
-    per_step = max(time.perf_counter() - start, 1e-9) / max(trial, 1)
+    while done < trial:             # in doubling chunks, until TRIAL_SECONDS
+        chunk = min(chunk, trial - done)
+        stepper.advance(model, state, warm + done + chunk)
+        done += chunk
+        chunk *= 2
+        if time.perf_counter() - start > TRIAL_SECONDS:
+            break
+    per_step = max(time.perf_counter() - start, 1e-9) / max(done, 1)
     active = sum(len(s.active) for s in state.bodies)
     vertices = sum(len(b.tributary_area) for b in model.bodies)
     writing = _writing(model, state)

@@ -7,8 +7,8 @@ builds on and which does not import it).
 import numpy as np
 
 from . import geometry
-from .geometry import MeshError, _arrays, _doubled_areas, _edge_keys, _edge_lengths
-from .kernels.tree import spatial_order
+from .geometry import (MeshError, _arrays, _doubled_areas, _edge_keys, _edge_lengths,
+                       spatial_order)
 
 #: area of the largest triangle whose edges are all <= 1 (equilateral)
 _LARGEST_UNIT_TRIANGLE = np.sqrt(3.0) / 4.0
@@ -66,7 +66,7 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=None, return_m
     shaped, so a long thin CAD triangle costs about what a well-shaped face of
     the same area does. The surface itself never changes. The vertices and
     faces of a mesh it refined come out sorted along a Morton curve
-    (:func:`meshwear.kernels.tree.spatial_order`: the face lookups and the
+    (:func:`meshwear.geometry.spatial_order`: the face lookups and the
     contact loop then read memory nearby).
 
     Parameters
