@@ -405,7 +405,8 @@ def write_docs(rows, ref, size_ratio, top, box, fine, sliding, turning, fine_fla
               "  shared 2-core machine that row was 1.36–1.50× (the contact kernel is compiled",
               "  for one per-vertex surface, as for one plane).",
               "- Fretting at real scale (a cylinder R = 6 mm, 1 mm long, at 20 µm, ±25 µm on",
-              "  a worn flat refined where the cylinder reaches it, `contact.margin` 5 µm):",
+              "  a worn flat refined where the cylinder reaches it, `contact.margin` 5 µm; on",
+              "  the plane, which is unbounded, more of the cylinder is refined):",
               f"  the flat at 10 µm costs {fine_flat:.2f}× the same cylinder on a plane"
               " (target ≤ 3×)",
               f"  and {flat_growth:.2f}× the flat at 40 µm (target 0.7–1.3×): a vertex that",

@@ -253,3 +253,46 @@ def counter_relief(model, s, m, increments, t):
         counter[on] += np.einsum("ij,ij->i", weights, increment[corners])
     m.counter = counter
     m.gamma = np.where(m.mean > 0.0, counter / np.where(m.mean > 0.0, m.mean, 1.0), 0.0)
+
+
+def counter_factors(model, state, measures, results, rates, jump, increments, t):
+    """Per worn counter-part ``j`` (``increments[j]``: its (V,) wear in the
+    resolved cycle, or None), the factor (V,) by which the implicit jump
+    relieves its wear over ``jump`` cycles, and the relative error (V,) of
+    that wear: the body vertices' own factors (their jumped wear over ``jump``
+    times their wear in the cycle) and error estimates carried to the counter
+    vertices under them, weighted by the counter's wear under each vertex
+    and the vertex's barycentric weights on the face it is over at ``t`` (the
+    end of the cycle). The same contact wears both, so the pressure the jump
+    relieves relieves the counter's wear as the body's; a counter vertex no
+    body vertex is over keeps its cycle's rate (factor 1)."""
+    out = []
+    for j, (surface, increment) in enumerate(zip(model.surfaces.per_vertex, increments)):
+        if increment is None:
+            out.append(None)
+            continue
+        weight = np.zeros(len(increment))
+        relief = np.zeros(len(increment))
+        error = np.zeros(len(increment))
+        for s, m, (wear, _, estimate), rate in zip(state.bodies, measures, results, rates):
+            index = m.index
+            face = s.hint[j][index]
+            on = (face >= 0) & (m.counter > 0.0) & (rate[index] > 0.0)
+            if not on.any():
+                continue
+            own = rate[index[on]] * jump
+            factor = wear[index[on]] / own
+            relative = estimate[index[on]] / own
+            weights, corners = surface.face_weights(vertex_feet(s, j, index[on]), face[on], t)
+            share = weights * m.counter[on][:, None]
+            for c in range(3):
+                np.add.at(weight, corners[:, c], share[:, c])
+                np.add.at(relief, corners[:, c], share[:, c] * factor)
+                np.add.at(error, corners[:, c], share[:, c] * relative)
+        covered = weight > 0.0
+        factor = np.ones(len(increment))
+        factor[covered] = relief[covered] / weight[covered]
+        relative = np.zeros(len(increment))
+        relative[covered] = error[covered] / weight[covered]
+        out.append((factor, relative))
+    return out

@@ -252,23 +252,31 @@ SAG_FRACTION = 0.01
 def refine_part(config, vertices, faces, face_mask=None):
     """A body's or mesh surface's mesh refined to its ``resolution`` where
     ``face_mask`` says (all faces by default), a primitive's vertices on its
-    exact surface (:func:`meshwear.geometry.snap_to_primitive`), a sphere's or cylinder's
-    edges short enough there for its facets to sag at most
-    :data:`SAG_FRACTION` of the resolution; and a summary for ``meshwear
+    exact surface (:func:`meshwear.geometry.snap_to_primitive`), its curved
+    faces there (a sphere's, a cylinder's side) with edges short enough to
+    sag at most :data:`SAG_FRACTION` of the resolution; and a summary for ``meshwear
     check``: ``refined_vertices`` (the vertices of the refined faces),
     ``vertices``, ``resolution``, ``shape`` (its type, None for a mesh
     file), ``sag`` (m, the largest facet sag where refined) and
     ``sag_elsewhere`` (m; both None but for a sphere or cylinder: mesh files
     keep their facets)."""
     resolution = float(config.resolution)
-    if config.shape is not None and config.shape.type in ("sphere", "cylinder"):
+    vertices, faces, mask = refine(vertices, faces, resolution, face_mask=face_mask,
+                                   return_mask=True)
+    shape = config.shape
+    if shape is not None and shape.type in ("sphere", "cylinder"):
         # a triangle with edges e on a sphere of radius R sags at most
         # rc^2 / (2 R) <= e^2 / (6 R) (rc its circumradius, <= e / sqrt 3):
-        # edges short enough for SAG_FRACTION of the resolution
-        resolution = min(resolution, float(np.sqrt(6.0 * config.shape.radius * SAG_FRACTION
-                                                   * resolution)))
-    vertices, faces, mask = refine(vertices, faces, resolution, face_mask=face_mask,
-                                          return_mask=True)
+        # the curved faces (not a cylinder's flat caps) get edges short
+        # enough for SAG_FRACTION of the resolution
+        fine = float(np.sqrt(6.0 * shape.radius * SAG_FRACTION * resolution))
+        curved = mask.copy()
+        if shape.type == "cylinder":
+            curved &= np.abs(geometry.face_normals(vertices, faces)[:, 2]) < geometry.SIDE
+        if fine < resolution and curved.any():
+            vertices, faces = refine(vertices, faces, fine, face_mask=curved)
+            # the refined faces: those as short as the resolution asks
+            mask = _edge_lengths(vertices, faces).max(axis=1) <= resolution * (1.0 + 1e-9)
     vertices = geometry.snap_to_primitive(config.shape, vertices, faces)
     sag = geometry.facet_sag(config.shape, vertices, faces)
     info = {"vertices": len(vertices), "refined_vertices": int(len(np.unique(faces[mask]))),

@@ -22,10 +22,11 @@ explicit
 
 A worn counter-part (docs/model.md, "Worn counter-surfaces") jumps with
 the bodies: its wear in the resolved cycle relieves the body vertices over it
-in the implicit step (:func:`meshwear.jumps.counter_relief`) and is itself
-extrapolated over the ``J`` cycles, ``J`` bounded by its slope criterion (as
-an explicit jump), by :data:`THETA` of the penetration of the body vertices
-over it, and by a fraction of its mesh spacing
+in the implicit step (:func:`meshwear.jumps.counter_relief`), and its own
+wear over the ``J`` cycles is relieved as theirs is (the same contact wears
+both: :func:`meshwear.jumps.counter_factors`), ``J`` bounded by the bodies'
+implicit step, by the sampling noise of the counter's wear per cycle and by
+a fraction of its mesh spacing
 (:data:`meshwear.kernels.counter_wear.SPACING_FRACTION`) per jump.
 
 Either way ``J`` grows by at most a factor :data:`GROWTH` from one jump to
@@ -81,7 +82,8 @@ class JumpState:
                                                      # last measured (None: not yet)
     # not saved with checkpoints: what the run has done since it (re)started,
     # for meshwear check's estimate
-    last_limit: str | None = None                   # the bound that set the latest jump
+    last_limit: str | None = None                   # the bound that set the latest jump,
+                                                    # or refused the latest cycle's
     fill_seconds: float = 0.0                       # wall time filling outputs from jumps
     filled_outputs: int = 0                         # outputs filled from jumps
     taken: list = field(default_factory=list)       # the jumps taken: (cycle it starts at,
@@ -209,13 +211,13 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                 jumps.counter_relief(model, s, m, increments, state.time)
             if forced_jump is None:
                 part_limit, part_which = _part_limit(model, parts, part_rates, js, measures,
-                                                     tolerance, end_limit)
+                                                     tolerance, end_limit, implicit)
         if implicit:
             jump, which, results = _choose_implicit(measures, rates, js, end_limit,
                                                     int(min(could, part_limit)), tolerance,
                                                     forced_jump)
-            if part_limit < could and which == "growth":
-                which = part_which
+            if part_limit < could and (which == "growth" or part_limit < 1):
+                which = part_which       # the counter-parts bounded it (or refused it)
         else:
             jump, which = end_limit, "end"
             if forced_jump is not None:
@@ -234,8 +236,13 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                 error += estimate
             js.limits[which] = js.limits.get(which, 0) + 1
             js.last_limit = which
+            factors = None
+            if parts and implicit:
+                # (before the jump moves the bodies: the feet at the cycle's end)
+                factors = jumps.counter_factors(model, state, measures, results, rates, jump,
+                                                increments, state.time)
             spans = _jump(model, state, before, rates, jump, results, measures)
-            part_spans = _jump_parts(model, parts, before_parts, part_rates, js, jump)
+            part_spans = _jump_parts(model, parts, before_parts, part_rates, js, jump, factors)
             before_fill = time.perf_counter()
             js.filled_outputs += filled.write(model, state, stop, jump, snapshots, spans,
                                               observers, check, part_spans)
@@ -244,6 +251,8 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
             js.taken.append((stop / n_c, jump, which))
             js.settling = not model.quasi_static
         js.last_jump = jump
+        if jump == 0:
+            js.last_limit = which        # why none was taken (the progress line says)
         js.rate = rates
         js.part_rate = part_rates
         if implicit:
@@ -380,12 +389,15 @@ def _jump(model, state, before, rates, jump, results, measures=None):
     return spans
 
 
-def _part_limit(model, parts, part_rates, js, measures, tolerance, end):
+def _part_limit(model, parts, part_rates, js, measures, tolerance, end, implicit=False):
     """The most cycles the worn counter-parts allow a jump, and the bound
-    that sets it: their slope criterion (as an explicit jump's), the
-    counter's wear under each body vertex within :data:`THETA` of its
-    penetration (the counter is extrapolated, not relieved), and a part
-    vertex sinking by at most SPACING_FRACTION of its spacing per jump."""
+    that sets it: a part vertex sinking by at most SPACING_FRACTION of its
+    spacing per jump, the sampling noise of its wear per cycle within the
+    tolerance, and, for explicit extrapolation, their slope criterion and
+    the counter's wear under each body vertex within :data:`THETA` of its
+    penetration. ``implicit``: the jump relieves the counter's wear as the
+    body's (:func:`meshwear.jumps.counter_factors`): the bodies' implicit
+    step bounds its accuracy and stability."""
     bounds = {}
     for k, ((j, part), rate, previous) in enumerate(zip(parts, part_rates, js.part_rate)):
         if rate.max(initial=0.0) <= 0.0:
@@ -399,15 +411,16 @@ def _part_limit(model, parts, part_rates, js, measures, tolerance, end):
         # tolerance
         if _counter_noise(js, k, rate, previous) > tolerance * rate.max():
             return 0, "counter noise"
-        jump, which = choose_jump(rate, previous, js.gap, np.zeros(len(rate)), tolerance,
-                                  js.last_jump, end, stability=False)
-        key = "counter accuracy" if which == "accuracy" else which
-        bounds[key] = min(bounds.get(key, np.inf), float(jump))
+        if not implicit:
+            jump, which = choose_jump(rate, previous, js.gap, np.zeros(len(rate)), tolerance,
+                                      js.last_jump, end, stability=False)
+            key = "counter accuracy" if which == "accuracy" else which
+            bounds[key] = min(bounds.get(key, np.inf), float(jump))
         spacing = model.surfaces.per_vertex[j].spacing
         sinking = rate > 0.0
         bounds["counter spacing"] = min(bounds.get("counter spacing", np.inf), float(
             (SPACING_FRACTION * spacing[sinking] / rate[sinking]).min()))
-    for m in measures:
+    for m in (measures if not implicit else ()):
         pressed = (m.counter > 0.0) & (m.depth > 0.0) & m.member
         if pressed.any():
             bounds["counter stability"] = min(bounds.get("counter stability", np.inf), float(
@@ -418,26 +431,36 @@ def _part_limit(model, parts, part_rates, js, measures, tolerance, end):
     return max(0, int(np.floor(bounds[which]))), which
 
 
-def _jump_parts(model, parts, before_parts, part_rates, js, jump):
+def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None):
     """Extrapolate each worn counter-part's wear in the last resolved cycle
-    over ``jump`` more cycles (its vertices moved to their new depth, their
-    faces' frames and the face grid renewed); return per part ``{name:
-    (array at the jump's start, at its end)}`` for depth, volume, work and
-    vertices."""
+    over ``jump`` more cycles, each vertex's relieved by its factor of
+    ``factors`` (per per-vertex surface: (factor, relative error) or None,
+    :func:`meshwear.jumps.counter_factors`; None: explicit) (its vertices
+    moved to their new depth, their faces' frames and the face tree
+    renewed); return per part ``{name: (array at the jump's start, at its
+    end)}`` for depth, volume, work and vertices."""
     spans = []
     for k, ((j, part), (_, volume0, work0), rate) in enumerate(
             zip(parts, before_parts, part_rates)):
         surface = model.surfaces.per_vertex[j]
         span = {name: getattr(part, name).copy() for name in PART_JUMPED}
-        part.depth += jump * rate
-        part.volume += jump * (part.volume - volume0)
-        part.work += jump * (part.work - work0)
+        scale = np.full(len(rate), float(jump))
+        relative = None
+        if factors is not None and factors[j] is not None:
+            scale = jump * factors[j][0]
+            relative = factors[j][1]
+        part.depth += scale * rate
+        part.volume += scale * (part.volume - volume0)
+        part.work += scale * (part.work - work0)
         part.vertices[:] = (surface.reference_vertices
                             - part.depth[:, None] * surface.vertex_normals)
         part.frames[:] = face_frames(part.vertices, surface.faces)
         surface.rebin()
         previous = js.part_rate[k]
-        js.part_error[k] += _slope_error(rate, previous, js.gap, jump)
+        if relative is not None:
+            js.part_error[k] += jump * rate * relative      # the bodies' implicit step's
+        else:
+            js.part_error[k] += _slope_error(rate, previous, js.gap, jump)
         if previous is not None:
             js.part_error[k] += jump * _counter_noise(js, k, rate, previous)
         spans.append({name: (span[name], getattr(part, name).copy()) for name in PART_JUMPED})
