@@ -11,9 +11,9 @@ import fcl
 import numpy as np
 
 from .. import geometry, remesh
+from ..kernels import tree
 from ..kernels.counter import MESH
 from ..kernels.laws import name_of as code_name
-from ..kernels import tree
 from ..kernels.nearest import (corner_normals, face_frames, nearest_planes_parallel,
                                nearest_planes_serial)
 from .base import CounterSurface, SurfaceMotion, axis_rotation, quaternion_matrix
