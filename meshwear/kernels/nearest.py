@@ -3,11 +3,11 @@
 A mesh counter-surface gives each vertex of a worn body the plane of its
 nearest face (docs/model.md: then the same point-plane contact). A vertex
 still over the face it had keeps it without a search; one that moved off it
-tries the faces across that face's edges, then searches a bounding-volume
-tree over the faces (:mod:`meshwear.kernels.tree`), in the surface's own
-frame, for the faces nearer than those, so a query costs O(log F) box tests
-and the faces near the vertex, whatever the mesh's size and however far it
-looks. Built once per surface: the surface moves as a rigid body, so its
+walks across edges to the face it is over now and keeps that one alike;
+otherwise it searches a bounding-volume tree over the faces
+(:mod:`meshwear.kernels.tree`), in the surface's own frame, no farther than
+the faces found, so a query costs O(log F) box tests and the faces near the
+vertex, whatever the mesh's size and however far it looks. Built once per surface: the surface moves as a rigid body, so its
 frame carries the tree; a worn one's boxes are grown by a slack and fitted
 anew once its wear passes it.
 
