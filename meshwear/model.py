@@ -12,7 +12,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import geometry, remesh, surfaces
-from .kernels import tree
 from .kernels.contact import LAW_SLOTS, all_vertices, contact, make_law, rotation_entries
 from .kernels.counter_wear import wear_counter
 from .kernels.laws import code_of
