@@ -139,6 +139,21 @@ def time_steps(scene, seconds):
     return elapsed / steps, len(s.active), len(s.wear_depth)
 
 
+def in_turns(scenes, seconds, rows):
+    """Time ``scenes`` ({label: scene}) in turns, three rounds, so all share
+    the machine alike; append the best of each to ``rows`` and print it."""
+    timings = {label: [] for label in scenes}
+    for _ in range(3):
+        for label, scene in scenes.items():
+            timings[label].append(time_steps(scene, seconds))
+    for label, times in timings.items():
+        t, active, n = min(times)
+        rows.append(dict(case=label, patch=active, vertices=n, active=active, seconds=t,
+                         rate=active / t))
+        print(f"  {label:34} {n:>9} {active:>7} {t * 1e6:10.1f} µs {active / t:10.3g}",
+              flush=True)
+
+
 PIN = """format = 1
 [run]
 mode = "quasi-static"
@@ -267,16 +282,7 @@ def main():
             scene_path = folder / f"pin_{len(pins)}.toml"
             scene_path.write_text(PIN.format(disc=disc, x=x, path=path))
             pins[label] = load_scene(scene_path)
-        timings = {label: [] for label in pins}
-        for _ in range(3):
-            for label, scene in pins.items():
-                timings[label].append(time_steps(scene, args.seconds / 2))
-        for label, times in timings.items():
-            t, active, n = min(times)
-            rows.append(dict(case=label, patch=active, vertices=n, active=active, seconds=t,
-                             rate=active / t))
-            print(f"  {label:34} {n:>9} {active:>7} {t * 1e6:10.1f} µs {active / t:10.3g}",
-                  flush=True)
+        in_turns(pins, args.seconds / 2, rows)
         # the fretting cylinder on a plane and on worn flats of 40 and 10 µm
         # faces (the same active set), timed in turns, the best of three
         flats = {}
@@ -288,16 +294,7 @@ def main():
             scene_path = folder / f"fretting_{len(flats)}.toml"
             scene_path.write_text(FRETTING_CYLINDER.format(flat=flat))
             flats[label] = load_scene(scene_path)
-        timings = {label: [] for label in flats}
-        for _ in range(3):
-            for label, scene in flats.items():
-                timings[label].append(time_steps(scene, args.seconds / 2))
-        for label, times in timings.items():
-            t, active, n = min(times)
-            rows.append(dict(case=label, patch=active, vertices=n, active=active, seconds=t,
-                             rate=active / t))
-            print(f"  {label:34} {n:>9} {active:>7} {t * 1e6:10.1f} µs {active / t:10.3g}",
-                  flush=True)
+        in_turns(flats, args.seconds / 2, rows)
 
     def find(case, patch, n):
         return next(r["seconds"] for r in rows
