@@ -51,18 +51,13 @@ def _capture(state):
 
 
 def phases(model, start, stop, cycles):
-    """The outputs a jump of up to ``cycles`` after the cycle ``start..stop``
-    could cover, as ``{step of this cycle: any of them a frame}``; the step
-    of this cycle is the one at the same phase (``stop`` for phase 0)."""
+    """The steps of the cycle ``start..stop`` at the phases of the outputs a
+    jump of up to ``cycles`` after it could cover (``stop`` for phase 0)."""
     n_c = stop - start
     schedule = model.output_steps
     inside = schedule[(schedule > stop) & (schedule < stop + cycles * n_c)]
-    out = {}
-    for o in inside.tolist():
-        phase = (o - start) % n_c
-        r = start + phase if phase else stop
-        out[r] = out.get(r, False) or o in model.frame_set
-    return out
+    phase = (inside - start) % n_c
+    return set(np.where(phase > 0, start + phase, stop).tolist())
 
 
 def record(model, state, start, stop, cycles, observers, progress, advance):
