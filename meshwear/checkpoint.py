@@ -102,6 +102,14 @@ def save(path, model, state, wall_time):
         for k, noise in enumerate(js.part_noise):
             if noise is not None:
                 arrays[f"jump_part{k}_noise"] = np.array(noise)
+        arrays["jump_noise_var"] = np.array(list(js.noise_var) + list(js.part_noise_var))
+        arrays["jump_window"] = np.array([js.window, js.relax])
+        arrays["jump_history_times"] = np.array([t for t, _, _ in js.history])
+        for h, (_, alphas, part_rates) in enumerate(js.history):
+            for k, alpha in enumerate(alphas or ()):
+                arrays[f"jump_history{h}_alpha{k}"] = alpha
+            for k, rate in enumerate(part_rates):
+                arrays[f"jump_history{h}_part{k}"] = rate
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
@@ -188,6 +196,18 @@ def load(path, model, state):
                         else None for k in range(len(worn))],
             gap=float(gap), last_jump=int(last), jumps=int(jumps), resolved_steps=int(resolved),
             settling=bool(settling), limits=limits)
+        js = state.jump
+        if "jump_window" in data:
+            window, relax = data["jump_window"]
+            js.window, js.relax = int(window), float(relax)
+            variance = [float(v) for v in data["jump_noise_var"]]
+            js.noise_var, js.part_noise_var = variance[:n], variance[n:]
+            for h, t in enumerate(data["jump_history_times"]):
+                alphas = [data[f"jump_history{h}_alpha{k}"].copy() for k in range(n)
+                          if f"jump_history{h}_alpha{k}" in data]
+                js.history.append((float(t), alphas or None,
+                                   [data[f"jump_history{h}_part{k}"].copy()
+                                    for k in range(len(worn))]))
     return float(wall)
 
 

@@ -31,9 +31,10 @@ in the relief above, while the vertex itself wears ``J alpha_i`` times its
 relieved penetration (:func:`counter_relief`; the counter-part's own wear is
 extrapolated in :mod:`meshwear.wear`).
 
-A jump is taken as two steps of ``J / 2`` (the second from the penetrations
-the first leaves); the same jump as one step of ``J`` differs from it by
-about its error (step doubling).
+A jump is taken as one, two and four steps of ``J``, each from the
+penetrations the one before leaves, and advances with their Richardson
+extrapolation (second order), its error estimated from the two
+extrapolations (:func:`implicit`).
 """
 
 from dataclasses import dataclass
@@ -92,6 +93,11 @@ def balance(depth, beta, stiffness, load):
     return float(z) if np.isfinite(z) else 0.0
 
 
+#: a vertex the surface it faces sees less than this share of is on a sharp
+#: edge: its mean penetration is taken on the share seen (:func:`measure`)
+RIM = 0.1
+
+
 @dataclass
 class BodyJump:
     """What one body's jumps need from its last resolved cycle, for the
@@ -128,11 +134,13 @@ def start_depths(model, body, s):
     return out
 
 
-def measure(model, body, s, rate, start=None):
-    """The :class:`BodyJump` of ``body`` after a resolved cycle in which it
-    wore ``rate`` (n,) (m per cycle), ``s.load`` holding the cycle's sums of
-    normal forces and their squares and ``start`` (n,) the penetrations at
-    its start (:func:`start_depths`; None: unknown).
+def measure(model, body, s, rate, start=None, window=1):
+    """The :class:`BodyJump` of ``body`` after ``window`` resolved cycles
+    in which it wore ``rate`` (n,) per cycle (m), ``s.load`` holding their
+    sums of normal forces and their squares and ``start`` (n,) the
+    penetrations at their start (:func:`start_depths`; None: unknown). (A
+    measurement averages over more than one cycle where single cycles
+    disagree; "the cycle" below is then the window.)
 
     The penetration while in contact is measured over the cycle, half a
     cycle before its end, and from each step's force, before that step's
@@ -148,11 +156,15 @@ def measure(model, body, s, rate, start=None):
     # the penetration while in contact: the force-weighted mean force over
     # the stiffness (the steps out of contact weigh nothing), the one at the
     # end of the cycle for a vertex pressed then (as its depth is), else that
-    # of its whole area: where a flank out of mesh or a disc's track away
-    # from the pin is at the end, it may face another surface, or none, or
-    # one seen at a slant
-    contact = np.where((depth > 0.0) & (stiffness > 0.0), stiffness,
-                       model.law[5] + model.law[6] * body.area_vectors[index, 3])
+    # of its whole area: a flank out of mesh or a disc's track away from
+    # the pin may face another surface then, or one at a slant. But where
+    # the surface it faces sees under a tenth of its area, that area lies
+    # mostly on faces that cannot touch (the end face of a pad, at its rim:
+    # taken whole, its mean penetration came out a hundred times too small
+    # and its jumps' error as large): the part seen is the part that touched
+    whole = model.law[5] + model.law[6] * body.area_vectors[index, 3]
+    edge = (stiffness > 0.0) & (stiffness < RIM * whole)
+    contact = np.where((depth > 0.0) & (stiffness > 0.0) | edge, stiffness, whole)
     touching = (contact > 0.0) & (force > 0.0)
     mean = np.zeros(len(index))
     mean[touching] = square[touching] / force[touching] / contact[touching]
@@ -172,7 +184,7 @@ def measure(model, body, s, rate, start=None):
     # step, rate * sum F^2 / (sum F)^2 (wear in proportion to the force),
     # puts the mean on the depths' footing (a steady contact's equals its depth)
     now = np.where(mean > 0.0, mean, np.where(np.isfinite(depth), depth, 0.0))
-    now[touching] -= rate[touching] * square[touching] / force[touching] ** 2
+    now[touching] -= window * rate[touching] * square[touching] / force[touching] ** 2
     if start is not None:
         change = np.where(np.isfinite(depth), depth, np.nan) - start[index]
         known = (mean > 0.0) & np.isfinite(change)
@@ -217,22 +229,49 @@ def _step(m, jump, depth, now):
     return jump * m.alpha * left, z, jump * rate * left
 
 
+def _steps(m, jump, n):
+    """``n`` backward-Euler steps of ``jump / n`` cycles, each from the
+    penetrations the one before leaves: (k,) wear and the move z."""
+    depth, now = m.depth, m.now
+    wear, z = np.zeros(len(depth)), 0.0
+    for _ in range(n):
+        w, dz, taken = _step(m, jump / n, depth, now)
+        # the move and the wear take the same off the penetration at every
+        # step in contact
+        shift = m.beta * dz + taken
+        depth, now = depth - shift, now - shift
+        wear, z = wear + w, z + dz
+    return wear, z
+
+
+def single_step(m, jump):
+    """One backward-Euler step of ``jump`` cycles: (k,) wear and the move z
+    (from the balance without a jump)."""
+    wear, z = _steps(m, jump, 1)
+    return wear, z - m.rest
+
+
 def implicit(m, jump):
     """Wear (k,) of the vertices ``m.index``, the body's move along its axis
     (m, from the balance without a jump) and the error estimate (k,) of a
-    jump of ``jump`` cycles, taken
-    as two backward-Euler steps of ``jump / 2``. The same jump as one step
-    differs from it by about its error (first order: the one step's error is
-    twice the two's), as in embedded Runge-Kutta pairs that advance with the
-    better of the two."""
-    whole, _, _ = _step(m, jump, m.depth, m.now)
-    half, z1, taken = _step(m, 0.5 * jump, m.depth, m.now)
-    # the move and the wear take the same off the penetration at every step
-    # in contact
-    shift = m.beta * z1 + taken
-    rest, z2, _ = _step(m, 0.5 * jump, m.depth - m.beta * z1 - taken, m.now - shift)
-    wear = half + rest
-    return wear, z1 + z2 - m.rest, np.abs(whole - wear)
+    jump of ``jump`` cycles.
+
+    Backward Euler is first order: one step, two and four steps of the
+    jump differ by errors in the ratio 4 : 2 : 1, so twice the four steps'
+    less the two's (Richardson extrapolation) is second order, as is twice
+    the two's less the one's, and the two extrapolations differ by three
+    times the error of the first: the jump advances with it and that
+    error (as embedded Runge-Kutta pairs advance with the better of their
+    two solutions). Its error grows like ``J^3``, so it allows longer jumps
+    than the first-order steps' ``J^2``; the extrapolated wear is kept
+    within zero and the vertex's four-step wear times two (where a vertex
+    leaves the contact within the jump the steps are not smooth)."""
+    one, z1 = _steps(m, jump, 1)
+    two, z2 = _steps(m, jump, 2)
+    four, z4 = _steps(m, jump, 4)
+    wear = np.clip(2.0 * four - two, 0.0, 2.0 * four)
+    coarse = 2.0 * two - one
+    return wear, 2.0 * z4 - z2 - m.rest, np.abs(wear - coarse) / 3.0
 
 
 def counter_relief(model, s, m, increments, t):
@@ -294,5 +333,18 @@ def counter_factors(model, state, measures, results, rates, jump, increments, t)
         factor[covered] = relief[covered] / weight[covered]
         relative = np.zeros(len(increment))
         relative[covered] = error[covered] / weight[covered]
+        # a vertex the bodies wore during the cycle but are not over at its
+        # end (the ends of a stroke, a track behind a pin) was worn by the
+        # same contact: it takes the relief of the nearest one they are over
+        # (left at its cycle's rate, it outwore its neighbours every jump,
+        # and the next cycles relaxed that as a burst of noise)
+        swept = ~covered & (increment > 0.0)
+        if swept.any() and covered.any():
+            from scipy.spatial import cKDTree
+
+            where = surface.reference_vertices
+            _, nearest = cKDTree(where[covered]).query(where[swept])
+            factor[swept] = factor[covered][nearest]
+            relative[swept] = relative[covered][nearest]
         out.append((factor, relative))
     return out

@@ -57,6 +57,13 @@ GROWTH = 2.0
 #: vertices wearing less than this fraction of the fastest one per cycle do not
 #: limit the jump (their rates are round-off or contact-edge flicker)
 SIGNIFICANT = 1e-3
+#: most consecutive resolved cycles one measurement averages its rates over
+MAX_WINDOW = 8
+#: the bounds that read sampling noise: when one holds the jumps under twice
+#: the cycles a measurement resolves, the measurements average over twice as many
+NOISY = ("noise", "counter noise")
+#: measurements (this one included) a vertex's drift and noise are fitted over
+HISTORY = 8
 
 
 @dataclass
@@ -80,6 +87,16 @@ class JumpState:
     part_noise: list = field(default_factory=list)  # per worn counter-part: the sampling
                                                      # noise of its wear per cycle (m), as
                                                      # last measured (None: not yet)
+    part_noise_var: list = field(default_factory=list)  # per worn counter-part: the
+                                                     # variance (m^2) the jumps' noise added
+                                                     # to its depth (random across jumps)
+    window: int = 1                                 # resolved cycles a measurement averages
+    history: list = field(default_factory=list)     # the measurements before at this window
+                                                    # (at most HISTORY - 1): (their middle,
+                                                    # cycles; per body alpha; per part rate)
+    relax: float = np.inf                           # cycles the contact relaxes errors over
+    noise_var: list = field(default_factory=list)  # per body: the variance (m^2) the jumps'
+                                                    # noise added to its depth
     # not saved with checkpoints: what the run has done since it (re)started,
     # for meshwear check's estimate
     last_limit: str | None = None                   # the bound that set the latest jump,
@@ -168,6 +185,10 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
     js = state.jump
     if len(js.part_noise) != len(parts):
         js.part_noise = [None] * len(parts)
+    if len(js.part_noise_var) != len(parts):
+        js.part_noise_var = [0.0] * len(parts)
+    if len(js.noise_var) != len(model.bodies):
+        js.noise_var = [0.0] * len(model.bodies)
     for body, s in zip(model.bodies, state.bodies):
         if s.load.shape[1] != len(s.wear_depth):
             s.load = np.zeros((2, len(s.wear_depth)))
@@ -183,13 +204,20 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                   if implicit and start > 0 else [None] * len(model.bodies))
         for s in state.bodies:
             s.load[:] = 0.0
-        stop = min(start + n_c, model.n_steps)
+        # a measurement averages the wear of ``window`` consecutive cycles
+        # (one, unless single cycles disagree): the last one is recorded for
+        # the outputs a jump after it fills
+        window = js.window
+        stop = min(start + window * n_c, model.n_steps)
+        last = max(start, stop - n_c)
+        if last > start:
+            advance(model, state, last, observers, progress)
         # the cycles a jump after this one may cover: the outputs in them are
         # filled from the states of this cycle at the same phase
         end_limit = max(0, (model.n_steps - stop - 1) // n_c)
         could = 0 if js.settling or forced_jump == 0 else min(
             end_limit, forced_jump if forced_jump is not None else int(GROWTH * js.last_jump + 1))
-        snapshots = filled.record(model, state, start, stop, could, observers, progress,
+        snapshots = filled.record(model, state, last, stop, could, observers, progress,
                                   advance)
         js.resolved_steps += stop - start
         if stop - start < n_c or state.step >= model.n_steps:
@@ -197,11 +225,15 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
         if js.settling:
             js.settling = False
             continue
-        rates = [s.wear_depth - b[0] for s, b in zip(state.bodies, before)]
-        part_rates = [p.depth - b[0] for (_, p), b in zip(parts, before_parts)]
-        measures = ([jumps.measure(model, body, s, rate, start)
+        rates = [(s.wear_depth - b[0]) / window for s, b in zip(state.bodies, before)]
+        part_rates = [(p.depth - b[0]) / window for (_, p), b in zip(parts, before_parts)]
+        measures = ([jumps.measure(model, body, s, rate, start, window)
                      for body, s, rate, start in zip(model.bodies, state.bodies, rates, starts)]
                     if implicit else None)
+        middle = state.step / n_c - 0.5 * window
+        for k, rate in enumerate(part_rates):
+            js.part_noise[k] = _counter_noise(js, k, rate, middle)
+        js.relax = _relaxation(measures)
         part_limit, part_which = float("inf"), None
         if parts:
             increments = [None] * len(state.parts)
@@ -211,11 +243,12 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                 jumps.counter_relief(model, s, m, increments, state.time)
             if forced_jump is None:
                 part_limit, part_which = _part_limit(model, parts, part_rates, js, measures,
-                                                     tolerance, end_limit, implicit)
+                                                     tolerance, end_limit, implicit,
+                                                     min(could, end_limit))
         if implicit:
-            jump, which, results = _choose_implicit(measures, rates, js, end_limit,
-                                                    int(min(could, part_limit)), tolerance,
-                                                    forced_jump)
+            jump, which, results = _choose_implicit(
+                measures, rates, js, end_limit, int(min(could, part_limit)), tolerance,
+                forced_jump, middle, [float(s.wear_depth.max(initial=0.0)) for s in state.bodies])
             if part_limit < could and (which == "growth" or part_limit < 1):
                 which = part_which       # the counter-parts bounded it (or refused it)
         else:
@@ -241,11 +274,14 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                 # (before the jump moves the bodies: the feet at the cycle's end)
                 factors = jumps.counter_factors(model, state, measures, results, rates, jump,
                                                 increments, state.time)
-            spans = _jump(model, state, before, rates, jump, results, measures)
-            part_spans = _jump_parts(model, parts, before_parts, part_rates, js, jump, factors)
+            spans = _jump(model, state, before, rates, jump, results, measures, window)
+            part_spans = _jump_parts(model, parts, before_parts, part_rates, js, jump, factors,
+                                     window)
             before_fill = time.perf_counter()
-            js.filled_outputs += filled.write(model, state, stop, jump, snapshots, spans,
-                                              observers, check, part_spans)
+            js.filled_outputs += filled.write(
+                model, state, stop, jump, snapshots, spans, observers, check, part_spans,
+                _progress(measures, results, jump) if implicit and forced_jump is None
+                else None)
             js.fill_seconds += time.perf_counter() - before_fill
             js.jumps += 1
             js.taken.append((stop / n_c, jump, which))
@@ -261,10 +297,45 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                 alpha = np.zeros(len(rate))
                 alpha[m.index] = np.where(m.mean > 0.0, m.alpha, 0.0)
                 js.alpha.append(alpha)
-        js.gap = jump + 1.0 + (1.0 if js.settling else 0.0)
+        js.history = (js.history + [(middle, js.alpha if implicit else None,
+                                      part_rates)])[1 - HISTORY:]
+        following = window
+        if (forced_jump is None and which in NOISY and jump < 2 * window
+                and window < MAX_WINDOW):
+            # single measurements disagree by more than the jumps they allow
+            # (a vertex at a contact's edge touched every other cycle, a
+            # flank switching between two rates): average over more cycles,
+            # and measure the noise and the drift again at that window
+            following = js.window = 2 * window
+            js.part_noise = [None] * len(parts)
+            js.history = []
+        # cycles between the middles of this measurement and the next
+        js.gap = jump + 0.5 * (window + following) + (1.0 if js.settling else 0.0)
         if checkpoint is not None:
             checkpoint(model, state)
     return state
+
+
+def _progress(measures, results, jump):
+    """Per body, the share of each vertex's wear (n,) and of the move done
+    at a fraction of an implicit jump's cycles: one backward-Euler step over
+    that fraction against one over the whole jump, so outputs filled inside
+    a long jump follow each vertex's own curve (the middle of a pin's scar
+    slowing, its edge starting, as the contact widens), not a straight line."""
+    whole = [jumps.single_step(m, jump) for m in measures]
+
+    def share(fraction):
+        if fraction <= 0.0 or fraction >= 1.0:
+            return [(fraction, fraction)] * len(measures)
+        out = []
+        for m, (wear, move), (full_wear, _, _) in zip(measures, whole, results):
+            part, part_move = jumps.single_step(m, fraction * jump)
+            full = np.full(len(full_wear), fraction)
+            worn = wear > 0.0
+            full[m.index[worn]] = np.clip(part[worn] / wear[worn], 0.0, 1.0)
+            out.append((full, float(np.clip(part_move / move, 0.0, 1.0)) if move else fraction))
+        return out
+    return share
 
 
 def _slope_error(rate, previous, gap, jump):
@@ -274,49 +345,98 @@ def _slope_error(rate, previous, gap, jump):
     return 0.5 * np.abs(rate - previous) / max(gap, 1.0) * jump * jump
 
 
-def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None):
+def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=0.0,
+                     deepest=None):
     """Cycles to jump over with implicit jumps, which bound set it, and per
     body the jump's ``(wear, move, error estimate)``.
 
     Bounds: ``end`` (the run ends with a resolved cycle), ``could`` (the
     growth bound the snapshots were taken for, or a forced jump), the drift
-    of each vertex's wear per unit penetration between the last two
-    measurements (``rho_alpha pbar J^2 / 2 <= tol J r_max``), and step
-    doubling (the jump's estimated error ``<= tol J r_max``)."""
+    of each vertex's wear per unit penetration over the measurements at
+    this window (``rho_alpha pbar J^2 / 2 <= tol J r_max``, :func:`_trend`),
+    its noise about that drift (random from jump to jump,
+    :func:`_noise_bound` against each body's ``deepest`` wear), and step
+    doubling (the jump's estimated error ``<= tol J r_max``). ``t``: the
+    middle of this measurement (cycles)."""
     fastest = max(float(r.max()) if len(r) else 0.0 for r in rates)
     if forced is not None:
         jump = min(end, could)
         return jump, "forced", _spread(measures, rates, jump)
-    if fastest <= 0.0 or any(a is None for a in js.alpha):
-        return 0, "accuracy", None
+    if fastest <= 0.0 or not js.history:
+        return 0, "measuring", None
     bounds = {"end": float(end), "growth": float(could)}
-    # per body, each measured vertex's drift of its wear per cycle, rho_i pbar_i
-    drifts = []
-    for m, previous in zip(measures, js.alpha):
-        previous = previous[m.index]
-        both = (m.mean > 0.0) & (previous > 0.0) & (m.alpha > 0.0)
-        rate = np.zeros(len(m.index))
-        rate[both] = np.abs(m.alpha[both] - previous[both]) / max(js.gap, 1.0) * m.mean[both]
-        drifts.append(rate)
+    # per body, each measured vertex's drift of its wear per cycle, rho_i pbar_i,
+    # and the noise of its wear per cycle about it, sigma_i pbar_i
+    trends = [_trend(m, [(time, alphas[k][m.index]) for time, alphas, _ in js.history], t)
+              for k, m in enumerate(measures)]
+    drifts = [d for d, _ in trends]
     drift = max(float(d.max(initial=0.0)) for d in drifts)
     if drift > 0.0:
         bounds["drift"] = 2.0 * tolerance * fastest / drift
+    for k, (_, noise) in enumerate(trends):
+        if noise is not None and len(noise) and deepest is not None:
+            bounds["noise"] = min(bounds.get("noise", np.inf), _noise_bound(
+                float(noise.max()), js.noise_var[k], tolerance, deepest[k],
+                float(rates[k].max(initial=0.0)), js.relax, min(end, could)))
     which = min(bounds, key=bounds.get)
     jump = int(np.floor(bounds[which]))
     for _ in range(12):
         if jump < 1:
-            return 0, "accuracy", None
+            return 0, which if which in ("noise", "drift") else "accuracy", None
         results = [jumps.implicit(m, jump) for m in measures]
         worst = max(float(e.max(initial=0.0)) for _, _, e in results) / (tolerance * jump
                                                                           * fastest)
         if worst <= 1.0:
             # the error estimate: step doubling's, and the drift's over the jump
+            # (the noise's, random from jump to jump, is kept apart)
             results = [(w, z, e + 0.5 * d * jump * jump)
                        for (w, z, e), d in zip(results, drifts)]
+            for k, (_, noise) in enumerate(trends):
+                if noise is not None and len(noise):
+                    js.noise_var[k] = _add_noise(js.noise_var[k], float(noise.max()), jump,
+                                                 js.relax)
             return jump, which, _spread(measures, rates, jump, results)
-        # the error grows like J^2, its allowance like J
-        jump, which = int(jump * min(0.9 / worst, 0.5 if worst > 2.0 else 0.9)), "accuracy"
+        # the error grows like J^3, its allowance like J
+        jump, which = int(jump * min(np.sqrt(0.9 / worst), 0.5 if worst > 4.0 else 0.9)), \
+            "accuracy"
     return 0, "accuracy", None
+
+
+def _trend(m, past, t):
+    """Per vertex of body measure ``m`` (measured at ``t``, cycles), the
+    drift of its wear per cycle (``rho_alpha pbar``, m per cycle per cycle)
+    and the noise of its wear per cycle about that drift (``sigma_alpha
+    pbar``, m per cycle; None with fewer than three measurements), from
+    :func:`_fit` of its wear per unit penetration ``alpha`` over ``past``
+    (earlier measurements at the same window: (time, alpha)) and this one.
+    Vertices not touching in every measurement have no drift (they enter or
+    leave the contact)."""
+    alpha = np.vstack([a for _, a in past] + [m.alpha])
+    slope, sigma = _fit(np.array([time for time, _ in past] + [t]), alpha)
+    both = (m.mean > 0.0) & np.all(alpha > 0.0, axis=0)
+    noise = None if sigma is None else np.where(both, sigma * m.mean, 0.0)
+    return np.where(both, slope * m.mean, 0.0), noise
+
+
+def _fit(times, values):
+    """A straight line fitted to each column of ``values`` (K, n) over
+    ``times`` (K,): (n,) the magnitude of its slope past the slope's own
+    uncertainty, and (n,) the scatter of the values about it (None with
+    fewer than three). Single measurements scatter about the line (a
+    vertex of a fine pad sliding over a finer worn flat sees its
+    penetration change facet by facet, one at a pad's rim is touched
+    every other cycle); counted as drift, that scatter would hold the
+    jumps, and it is random from jump to jump."""
+    centred = times - times.mean()
+    spread = float(centred @ centred)
+    if spread <= 0.0:
+        return np.zeros(values.shape[1]), None
+    slope = centred @ (values - values.mean(axis=0)) / spread
+    if len(times) < 3:
+        return np.abs(slope), None
+    residual = values - values.mean(axis=0) - np.outer(centred, slope)
+    sigma = np.sqrt((residual * residual).sum(axis=0) / (len(times) - 2))
+    return np.maximum(np.abs(slope) - 2.0 * sigma / np.sqrt(spread), 0.0), sigma
 
 
 def _spread(measures, rates, jump, results=None):
@@ -335,9 +455,11 @@ def _spread(measures, rates, jump, results=None):
 JUMPED = ("vertices", "wear_depth", "wear_volume", "friction_work")
 
 
-def _jump(model, state, before, rates, jump, results, measures=None):
-    """Extrapolate the last resolved cycle over ``jump`` more cycles, each
-    body's wear and move along its axis given by ``results``; return per body
+def _jump(model, state, before, rates, jump, results, measures=None, window=1):
+    """Extrapolate the last measurement (``window`` resolved cycles, their
+    per-cycle wear ``rates``, ``before`` the arrays at their start) over
+    ``jump`` more cycles, each body's wear and move along its axis given
+    by ``results``; return per body
     ``{name: (array at the jump's start, at its end)}`` for the :data:`JUMPED`
     arrays, and ``shift``, the move of its position."""
     spans = []
@@ -354,6 +476,7 @@ def _jump(model, state, before, rates, jump, results, measures=None):
         factor = np.full(len(rate), float(jump))
         wearing = rate > 0.0
         factor[wearing] = wear[wearing] / rate[wearing]
+        factor /= window                 # the increments are the window's
         work = s.friction_work - work0
         volume = s.wear_volume - volume0
         s.vertices += factor[:, None] * (s.vertices - vertices0)
@@ -389,7 +512,8 @@ def _jump(model, state, before, rates, jump, results, measures=None):
     return spans
 
 
-def _part_limit(model, parts, part_rates, js, measures, tolerance, end, implicit=False):
+def _part_limit(model, parts, part_rates, js, measures, tolerance, end, implicit=False,
+                most=None):
     """The most cycles the worn counter-parts allow a jump, and the bound
     that sets it: a part vertex sinking by at most SPACING_FRACTION of its
     spacing per jump, the sampling noise of its wear per cycle within the
@@ -406,11 +530,17 @@ def _part_limit(model, parts, part_rates, js, measures, tolerance, end, implicit
             return 0, "counter accuracy"
         # a counter vertex's wear in one cycle is sampled by the steps of the
         # passes over it, and differs from cycle to cycle by that sampling
-        # (a pass over a track's edge takes a few steps); a jump multiplies
-        # one cycle's, so it is taken only where that noise stays within the
-        # tolerance
-        if _counter_noise(js, k, rate, previous) > tolerance * rate.max():
+        # (a pass over a track's edge takes a few steps, a vertex at the rim
+        # of a pad is touched every other cycle); a jump multiplies one
+        # measurement's, its error random from jump to jump
+        if js.part_noise[k] is None:
+            return 0, "measuring"
+        most = end if most is None else most
+        bound = _noise_bound(js.part_noise[k], js.part_noise_var[k], tolerance,
+                             float(part.depth.max()), float(rate.max()), js.relax, most)
+        if bound < 1.0 <= most:
             return 0, "counter noise"
+        bounds["counter noise"] = min(bounds.get("counter noise", np.inf), bound)
         if not implicit:
             jump, which = choose_jump(rate, previous, js.gap, np.zeros(len(rate)), tolerance,
                                       js.last_jump, end, stability=False)
@@ -431,14 +561,15 @@ def _part_limit(model, parts, part_rates, js, measures, tolerance, end, implicit
     return max(0, int(np.floor(bounds[which]))), which
 
 
-def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None):
-    """Extrapolate each worn counter-part's wear in the last resolved cycle
-    over ``jump`` more cycles, each vertex's relieved by its factor of
-    ``factors`` (per per-vertex surface: (factor, relative error) or None,
-    :func:`meshwear.jumps.counter_factors`; None: explicit) (its vertices
-    moved to their new depth, their faces' frames and the face tree
-    renewed); return per part ``{name: (array at the jump's start, at its
-    end)}`` for depth, volume, work and vertices."""
+def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None, window=1):
+    """Extrapolate each worn counter-part's wear per cycle in the last
+    measurement (of ``window`` resolved cycles, ``before_parts`` the arrays
+    at its start) over ``jump`` more cycles, each vertex's relieved by its
+    factor of ``factors`` (per per-vertex surface: (factor, relative error)
+    or None, :func:`meshwear.jumps.counter_factors`; None: explicit) (its
+    vertices moved to their new depth, their faces' frames and the face
+    tree renewed); return per part ``{name: (array at the jump's start, at
+    its end)}`` for depth, volume, work and vertices."""
     spans = []
     for k, ((j, part), (_, volume0, work0), rate) in enumerate(
             zip(parts, before_parts, part_rates)):
@@ -450,8 +581,8 @@ def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None):
             scale = jump * factors[j][0]
             relative = factors[j][1]
         part.depth += scale * rate
-        part.volume += scale * (part.volume - volume0)
-        part.work += scale * (part.work - work0)
+        part.volume += scale / window * (part.volume - volume0)
+        part.work += scale / window * (part.work - work0)
         part.vertices[:] = (surface.reference_vertices
                             - part.depth[:, None] * surface.vertex_normals)
         part.frames[:] = face_frames(part.vertices, surface.faces)
@@ -461,30 +592,69 @@ def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None):
             js.part_error[k] += jump * rate * relative      # the bodies' implicit step's
         else:
             js.part_error[k] += _slope_error(rate, previous, js.gap, jump)
-        if previous is not None:
-            js.part_error[k] += jump * _counter_noise(js, k, rate, previous)
+        if js.part_noise[k] is not None:
+            # the noise of one measurement's rate, times the jump: random
+            # from jump to jump, so the jumps' errors add in quadrature
+            js.part_noise_var[k] = _add_noise(js.part_noise_var[k], js.part_noise[k], jump,
+                                              js.relax)
         spans.append({name: (span[name], getattr(part, name).copy()) for name in PART_JUMPED})
     return spans
 
 
-def _noise(rate, previous):
-    """Half the largest change of a counter vertex's wear per cycle between
-    two measurements: the sampling noise of one cycle's wear, at most."""
-    return 0.5 * float(np.abs(rate - previous).max())
+def _noise_bound(noise, variance, tolerance, deepest, fastest, relax, most):
+    """The longest jump, at most ``most`` cycles, whose noise keeps a
+    part's random error within the tolerance. A jump's error, ``J`` times
+    the noise ``sigma`` (m per cycle) of the rate it extrapolates, is random
+    from jump to jump, so the jumps' errors add in quadrature
+    (:func:`_add_noise`; ``variance`` so far, m^2), and the contact relaxes
+    them as it does any error of depth (over ``relax`` cycles, the inverse
+    of its wear per cycle per unit penetration): the jump is taken when
+    ``variance e^(-2J/relax) + (J sigma)^2 <= (tol (deepest + J r))^2``,
+    ``deepest + J r`` the depth the part will have (``fastest`` its fastest
+    rate r)."""
+    jump = int(most)
+    while jump >= 1:
+        if _add_noise(variance, noise, jump, relax) <= (tolerance * (deepest + jump * fastest)) ** 2:
+            return jump
+        jump = int(jump * 0.8) if jump > 4 else jump - 1
+    return 0
 
 
-def _counter_noise(js, k, rate, previous):
-    """The sampling noise of worn counter-part ``k``'s wear per cycle
-    (:func:`_noise`), measured between two consecutive resolved cycles.
-    Across a jump the change between the two measurements also holds the
-    drift of the wear rate over the jumped cycles (the slope criterion's
-    part), which grows with the jump: taken for noise, it refused jumps
-    once they were long and the controller fell back to jumps of a few
-    cycles (the gear pair past a few thousand revolutions). There the noise
-    last measured between consecutive cycles stands."""
-    if js.gap <= 1.0 or js.part_noise[k] is None:
-        js.part_noise[k] = _noise(rate, previous)
-    return js.part_noise[k]
+def _add_noise(variance, noise, jump, relax):
+    """The variance (m^2) of a part's depth from the noise of its jumps'
+    rates, after one more jump of ``jump`` cycles with noise ``noise`` (m per
+    cycle): what it was, relaxed over the jump by the contact (a vertex worn
+    too deep carries less and wears less, ``relax`` cycles its time
+    constant), plus the new jump's."""
+    decay = np.exp(-2.0 * jump / relax) if np.isfinite(relax) and relax > 0.0 else 1.0
+    return variance * decay + (jump * noise) ** 2
+
+
+def _relaxation(measures):
+    """The cycles over which the contact relaxes an error of depth (the
+    inverse of the median, over the vertices in contact, of their own and
+    their counter-part's wear per cycle per unit penetration); inf when
+    nothing wears."""
+    rates = [(m.alpha if m.gamma is None else m.alpha + m.gamma)[m.member & (m.alpha > 0.0)]
+             for m in measures or ()]
+    rates = np.concatenate(rates) if rates else np.zeros(0)
+    middle = float(np.median(rates)) if len(rates) else 0.0
+    return 1.0 / middle if middle > 0.0 else np.inf
+
+
+def _counter_noise(js, k, rate, t):
+    """The sampling noise of worn counter-part ``k``'s wear per cycle (m):
+    the largest scatter (:func:`_fit`) of a vertex's rate about a straight
+    line through its rates ``rate`` in this measurement (its middle at
+    ``t``, cycles) and the ones before at the same window (its drift taken
+    off: the rates of a contact that widens fall cycle after cycle, and
+    that is no noise). None before three measurements."""
+    past = [(time, rates[k]) for time, _, rates in js.history if rates[k] is not None]
+    if len(past) < 2:
+        return None
+    _, sigma = _fit(np.array([time for time, _ in past] + [t]),
+                    np.vstack([r for _, r in past] + [rate]))
+    return float(sigma.max())
 
 
 #: the arrays of a worn counter-part a jump extrapolates
@@ -512,8 +682,11 @@ def error_estimate(state):
         return 0.0
     worst = 0.0
     worn = [p.depth for p in state.parts if p is not None]
-    for error, depth in zip(js.error + js.part_error, [s.wear_depth for s in state.bodies] + worn):
+    noise = ([float(np.sqrt(v)) for v in js.noise_var] + [0.0] * len(js.error))[:len(js.error)]
+    noise += ([float(np.sqrt(v)) for v in js.part_noise_var] + [0.0] * len(worn))[:len(worn)]
+    for error, depth, random in zip(js.error + js.part_error,
+                                    [s.wear_depth for s in state.bodies] + worn, noise):
         deepest = depth.max() if len(depth) else 0.0
         if deepest > 0.0:
-            worst = max(worst, float(error.max() / deepest))
+            worst = max(worst, float((error.max() + random) / deepest))
     return worst

@@ -278,7 +278,7 @@ def test_a_checkpoint_inside_a_jumped_run_resumes_it(tmp_path):
     """A jumped run saved after a jump and resumed ends where the whole run
     does: the counter-part's wear and the jump controller's memory of it
     are in the checkpoint."""
-    model = build_model(load_scene(_jumped(tmp_path, 6)))
+    model = build_model(load_scene(_jumped(tmp_path, 10)))
     saved = []
 
     def save(model, state):
@@ -525,25 +525,25 @@ def test_a_turning_body_swept_over_a_counter_part_s_edge_rests_on_its_top(tmp_pa
     assert state.parts[0].volume.sum() / s.wear_volume.sum() == pytest.approx(0.5, rel=1e-9)
 
 
-def test_counter_noise_is_measured_between_consecutive_cycles_only():
-    """Across a jump the change of a counter vertex's wear per cycle holds the
-    rate's drift over the jumped cycles too (the slope criterion's part): the
-    noise measured last between consecutive resolved cycles stands there, or
-    long jumps would be refused as noisy (the gear pair's jumps collapsed)."""
+def test_counter_noise_is_the_scatter_about_the_rates_drift():
+    """A counter vertex's sampling noise is the scatter of its wear per
+    cycle about a straight line through the measurements at the same
+    window: a drift (a widening contact's rates fall cycle after cycle,
+    however long the jumps between the measurements) is no noise; a vertex
+    touched every other cycle, or whose rate scatters, is; fewer than three
+    measurements, not yet measured."""
     from meshwear.wear import JumpState, _counter_noise
 
-    previous = np.array([1.0e-9, 2.0e-9, 0.0])
-    js = JumpState(gap=1.0, part_noise=[None])
-    consecutive = previous + np.array([0.0, 2.0e-11, 0.0])          # sampling: 1 % at most
-    assert _counter_noise(js, 0, consecutive, previous) == pytest.approx(1e-11)
-    js.gap = 65.0                                                     # after a jump of 64
-    drifted = previous * 1.3                                          # the rate moved on
-    assert _counter_noise(js, 0, drifted, previous) == pytest.approx(1e-11)
-    js.gap = 1.0                                                      # consecutive again
-    assert _counter_noise(js, 0, drifted, previous) == pytest.approx(0.5 * 0.3 * 2e-9)
-    # no measurement between consecutive cycles yet (a resumed run): the change stands
-    js = JumpState(gap=65.0, part_noise=[None])
-    assert _counter_noise(js, 0, drifted, previous) == pytest.approx(0.5 * 0.3 * 2e-9)
+    base = np.array([1.0e-9, 2.0e-9, 0.0])
+    drifting = [(t, None, [base * (1.0 - 0.002 * t)]) for t in (10.0, 50.0, 51.0)]
+    js = JumpState(history=drifting)
+    assert _counter_noise(js, 0, base * (1.0 - 0.002 * 300.0), 300.0) == pytest.approx(
+        0.0, abs=1e-22)
+    # one vertex alternating by +-10 % about its rate
+    flicker = [(t, None, [base * (1.0 + 0.1 * (-1) ** t)]) for t in range(3)]
+    sigma = _counter_noise(JumpState(history=flicker), 0, base * 0.9, 3.0)
+    assert 0.05 * 2e-9 < sigma < 0.2 * 2e-9
+    assert _counter_noise(JumpState(history=drifting[:1]), 0, base, 60.0) is None
 
 
 def test_a_worn_surface_s_tree_is_fitted_anew_only_once_its_wear_passes_the_slack(tmp_path):

@@ -322,8 +322,8 @@ def test_an_implicit_jump_s_error_estimate_holds_the_drift_it_was_bounded_by():
                  beta=np.zeros(k), load=0.0, guided=False)
     previous = alpha.copy()
     previous[0] *= 1.001                            # vertex 0's changed by 0.1 % over 10 cycles
-    js = JumpState(alpha=[previous], gap=10.0)
-    jump, which, results = _choose_implicit([m], [alpha * p], js, 10**6, 100, 0.01)
+    js = JumpState(alpha=[previous], gap=10.0, history=[(0.0, [previous], [])])
+    jump, which, results = _choose_implicit([m], [alpha * p], js, 10**6, 100, 0.01, t=10.0)
     assert (jump, which) == (100, "growth")         # the drift allows 200
     _, _, doubling = implicit(m, jump)
     drift = 0.5 * (1e-3 * 1e-6 / 10.0) * p * jump ** 2

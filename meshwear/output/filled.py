@@ -74,14 +74,18 @@ def record(model, state, start, stop, cycles, observers, progress, advance):
     return snapshots
 
 
-def write(model, state, stop, jump, snapshots, spans, observers, check, part_spans=()):
+def write(model, state, stop, jump, snapshots, spans, observers, check, part_spans=(),
+          progress=None):
     """Write every output strictly inside the span the jump just covered
     (``stop`` to ``stop + jump`` cycles), filled from it (``spans``: per body,
     the jumped arrays at its start and end, and the shift of its position;
     ``part_spans`` the same per worn counter-part, in the order of
     ``state.parts``); ``check(model, state, face_normals)`` refuses an
-    invalid state (:func:`meshwear.simulate.check`). Returns the number of
-    outputs written."""
+    invalid state (:func:`meshwear.simulate.check`). ``progress(f)``: per
+    body, the share of each vertex's wear (n,) and of the move done at the
+    fraction ``f`` of the jump's cycles (the implicit jump's own curve: the
+    middle of a pin's scar slows as its edge comes into contact; None: ``f``
+    for all). Returns the number of outputs written."""
     n_c = model.cycle_steps
     end = stop + jump * n_c
     schedule = model.output_steps
@@ -91,10 +95,13 @@ def write(model, state, stop, jump, snapshots, spans, observers, check, part_spa
         phase = (o - start) % n_c
         shots = snapshots[phase if phase else n_c]
         fraction = (o - stop) / (end - stop)
+        shares = (progress(fraction) if progress is not None
+                  else [(fraction, fraction)] * len(spans))
         view = copy.copy(state)
         view.step, view.time = o, o * model.dt
-        view.bodies = [_view(body, s, shot, span, fraction, view.time)
-                       for body, s, shot, span in zip(model.bodies, state.bodies, shots, spans)]
+        view.bodies = [_view(body, s, shot, span, share, view.time)
+                       for body, s, shot, span, share in zip(model.bodies, state.bodies, shots,
+                                                             spans, shares)]
         if part_spans:
             spans_left = iter(part_spans)
             view.parts = [None if p is None else _interpolated(p, next(spans_left), fraction)
@@ -119,18 +126,21 @@ def _interpolated(part, span, fraction):
     return view
 
 
-def _view(body, s, shot, span, fraction, t):
-    """A body state at ``fraction`` of the jump, with the contact of ``shot``."""
+def _view(body, s, shot, span, share, t):
+    """A body state part way through the jump (``share``: of each vertex's
+    wear, a scalar or (n,), and of the move), with the contact of ``shot``."""
+    fraction, moved = share
     view = copy.copy(s)
     view.pose = shot.pose.copy()
-    view.pose[0:3] += fraction * span["shift"]
+    view.pose[0:3] += moved * span["shift"]
     body.motion.place(view.pose, t)
     view.wrench = shot.wrench
     view.contact_state = shot.contact_state
     for name, value in span.items():
         if name != "shift":
             first, last = value
-            setattr(view, name, first + fraction * (last - first))
+            f = np.reshape(fraction, np.shape(fraction) + (1,) * (first.ndim - np.ndim(fraction)))
+            setattr(view, name, first + f * (last - first))
     touching = shot.touching
     view.normal_force = np.zeros_like(s.normal_force)
     view.normal_force[:, touching] = shot.normal_force
