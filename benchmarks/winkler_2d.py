@@ -145,25 +145,16 @@ def scar(x, w):
 
 
 def section(path, axis_y=0.0):
-    """The wear profile (x, depth) along x of a 3-D frame's surface on the
-    section y = axis_y: the vertices within half a spacing of it that wore,
-    their depth against x (sorted)."""
+    """The wear profile (x, depth) along x of a 3-D frame's surface cut by
+    the plane y = axis_y (its depth interpolated along the cut): the part of
+    the cut within 0.1 mm of z = 0, where the two touch (sorted along x)."""
     import pyvista
 
-    mesh = pyvista.read(path)
-    points, depth = np.asarray(mesh.points), np.asarray(mesh.point_data["wear_depth"])
-    y = points[:, 1] - axis_y
-    near = np.abs(y) <= 0.5 * _spacing(points[depth > 0.0, 1]) + 1e-12
-    keep = near & (depth > 0.0)
+    cut = pyvista.read(path).slice(normal="y", origin=(0.0, axis_y, 0.0))
+    points, depth = np.asarray(cut.points), np.asarray(cut.point_data["wear_depth"])
+    keep = np.abs(points[:, 2]) < 1e-4
     order = np.argsort(points[keep, 0])
     return points[keep, 0][order], depth[keep][order]
-
-
-def _spacing(values):
-    """The smallest spacing between distinct values (a grid's step)."""
-    distinct = np.unique(np.round(values, 9))
-    steps = np.diff(distinct)
-    return float(steps[steps > 0].min()) if len(steps) else 0.0
 
 
 def frames(out, name):

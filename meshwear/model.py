@@ -629,20 +629,24 @@ def initial_state(model):
         surfaces.update(model, body, s, 0.0)
     if model.quasi_static:
         # the bodies already sit in balance at t = 0: evaluate their contacts
-        # there (at rest, so nothing slips or wears), for the t = 0 outputs
-        # and the stick anchors the first step starts from
+        # there (at rest, so nothing slips or wears: a step of no duration,
+        # even where a surface turns under them), for the t = 0 outputs and
+        # the stick anchors the first step starts from
+        at_rest = model.law.copy()
+        at_rest[LAW_SLOTS.index("dt")] = 0.0
         for body, s in zip(model.bodies, state.bodies):
             s.pose[7:13] = 0.0
-            body_contact(model, body, s)
+            body_contact(model, body, s, at_rest)
     return state
 
 
-def body_contact(model, body, s):
+def body_contact(model, body, s, law=None):
     """One step of the contact kernel for one body (planes and mesh surfaces,
-    its active vertices)."""
+    its active vertices); ``law`` in place of the model's."""
     contact(s.vertices, s.pose, model.planes, s.vertex_planes, s.active, body.area_vectors,
-            model.law, body.wear_direction, s.contact_state, s.tangential, s.normal_force,
-            s.friction_work, s.wear_depth, s.wear_volume, s.wrench)
+            model.law if law is None else law, body.wear_direction, s.contact_state,
+            s.tangential, s.normal_force, s.friction_work, s.wear_depth, s.wear_volume,
+            s.wrench)
 
 
 def wear_counters(model, body, s, t):

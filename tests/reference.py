@@ -84,7 +84,9 @@ def contact(body_vertices, pose, planes, vertex_planes, active, area_vectors, la
         held = touching & (state == STICK)
         anchor[held] += dt * vel[held]
         new = touching & (state == NO_CONTACT)
-        anchor[new], F0[new], v_old[new] = on_plane[new], 0.0, slip_v[new]
+        # where it came into contact: on the plane at the step's start
+        anchor[new] = on_plane[new] - dt * slip_v[new]
+        F0[new], v_old[new] = 0.0, slip_v[new]
         reversed_ = touching & (state == SLIP) & (_dot(slip_v, v_old) < 0.0)
         # stick starts at the turning point, one step back along the slip velocity
         anchor[reversed_] = on_plane[reversed_] - dt * slip_v[reversed_]

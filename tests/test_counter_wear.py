@@ -502,10 +502,11 @@ def test_a_turning_body_swept_over_a_counter_part_s_edge_rests_on_its_top(tmp_pa
     depth of the elastic approach, nearer the side face at first; deep under
     it, they let go of it for the top face (nearest.RELEASE), so the disc
     stays in balance on the pin's top (it sank through the pin before). A
-    vertex that came in this very step (it starts in stick) may still be
-    nearer the side than RELEASE allows (the pin's side is exact, the
-    vertex 0.3 um under the top and up to 16 times that inside the side):
-    it pushes on the side for that step only, with a fraction of the load."""
+    vertex that came in this very step may still be nearer the side than
+    RELEASE allows (the pin's side is exact, the vertex 0.3 um under the
+    top and up to 16 times that inside the side): it pushes on the side
+    for that step only (slipping at once, the disc turning over it), with
+    a fraction of the load."""
     from meshwear.kernels.contact import SLIP
 
     path = tmp_path / "disc_over_pin.toml"
@@ -516,7 +517,8 @@ def test_a_turning_body_swept_over_a_counter_part_s_edge_rests_on_its_top(tmp_pa
     touching = s.normal_force[0] > 0.0
     sliding = touching & (s.contact_state[0] == SLIP)
     assert sliding.sum() > 30
-    assert s.vertex_planes[0][sliding][:, 1, 2].min() > 0.999
+    on_top = s.vertex_planes[0][:, 1, 2] > 0.999
+    assert (sliding & ~on_top).sum() <= 0.05 * sliding.sum()
     on_side = touching & (s.vertex_planes[0][:, 1, 2] < 0.999)
     assert s.normal_force[0][on_side].sum() < 0.01 * s.normal_force[0].sum()
     assert 0.000999 < s.pose[2] < 0.001

@@ -377,7 +377,7 @@ def test_balance_offset_matches_numpy_twin(load, opposed, scaled):
     static = law.copy()
     static[[7, 8, 11, 12]] = 0.0   # no damping, and planes at rest: only normal forces
     resting, resting_vertex = planes.copy(), vertex_planes.copy()
-    resting[:, 2] = resting_vertex[:, :, 2] = 0.0
+    resting[:, 2:4] = resting_vertex[:, :, 2:4] = 0.0   # nor turning: no slip in the step
     s.update(vertex_planes=resting_vertex, active=active)
     _call(reference.contact, vertices.copy(), moved, resting, params, static, direction, s)
     assert s["wrench"][0:3] @ axis == pytest.approx(load, rel=1e-9)
@@ -471,3 +471,37 @@ def test_a_steady_turn_matches_its_numpy_twin():
             np.testing.assert_allclose(pose[0:3], start + moved - (moved @ free) * free,
                                        atol=1e-12)
             np.testing.assert_allclose(pose[7:10], speed - (speed @ free) * free, atol=1e-12)
+
+
+@pytest.mark.parametrize("kernel", [contact.contact_serial, reference.contact])
+def test_a_point_touching_down_on_a_sliding_surface_slips_in_its_first_step(kernel):
+    """A new contact is anchored where it came into contact, at the step's
+    start (docs/model.md, transitions, rule 1): a point touching down on a
+    plane that slides under it at v stretches its spring by v dt in that
+    step and slips at once, wearing, where c_t v dt > f0 N; one touching
+    down at rest holds (no force, no wear)."""
+    dt, v, c = 1e-3, 0.01, 1e6                        # c_t v dt = 10 N, f0 N = 0.5 N
+    law = contact.make_law(friction=0.4, static_friction=0.5, wear_law="archard",
+                           wear_coefficient=1e-13, dt=dt, stiffness=c, tangential_stiffness=c)
+    vertices = np.zeros((1, 3))
+    params = np.array([[0.0, 0.0, -1e-6, 1e-6]])      # its area faces the plane below
+    out = {}
+    for speed in (v, 0.0):
+        pose = np.zeros(13)
+        pose[2], pose[3] = -1e-6, 1.0                  # 1 um into the plane z = 0: N = 1 N
+        planes = np.zeros((1, 4, 3))
+        planes[0, 1] = [0.0, 0.0, 1.0]
+        planes[0, 2] = [speed, 0.0, 0.0]               # the plane slides along x
+        a = dict(contact_state=np.zeros((1, 1), np.int8), tangential=np.zeros((1, 1, 4, 3)),
+                 normal_force=np.zeros((1, 1)), friction_work=np.zeros(1),
+                 wear_depth=np.zeros(1), wear_volume=np.zeros(1), wrench=np.zeros(6))
+        _call(kernel, vertices, pose, planes, params, law, np.zeros((0, 3)), a)
+        out[speed] = a
+    sliding, resting = out[v], out[0.0]
+    assert sliding["normal_force"][0, 0] == pytest.approx(1.0)
+    assert sliding["contact_state"][0, 0] == contact.SLIP
+    assert sliding["tangential"][0, 0, contact.FORCE] == pytest.approx([0.4, 0.0, 0.0])
+    assert sliding["wear_depth"][0] > 0.0 and sliding["friction_work"][0] == pytest.approx(
+        0.4 * 1.0 * v * dt)
+    assert resting["contact_state"][0, 0] == contact.STICK
+    assert resting["wear_depth"][0] == 0.0 and not resting["tangential"][0, 0, contact.FORCE].any()

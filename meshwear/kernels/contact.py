@@ -247,10 +247,17 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
                 tangential[s, i, ANCHOR, 2] += svz * dt
             elif state == NO_CONTACT:
                 # a new contact starts in stick with F0 = 0 at its position
+                # when it came into contact, within this step: its position
+                # on the plane at the step's start, so the step's slip
+                # stretches the spring and a point touching down on a
+                # surface sliding under it slips at once where that exceeds
+                # f0 N (anchored at its end, it held one step without slip
+                # or wear, and vertices riding over a worn mesh's facets,
+                # touching down step after step, never wore)
                 state = STICK
-                tangential[s, i, ANCHOR, 0] = ax
-                tangential[s, i, ANCHOR, 1] = ay
-                tangential[s, i, ANCHOR, 2] = az
+                tangential[s, i, ANCHOR, 0] = ax - sx * dt
+                tangential[s, i, ANCHOR, 1] = ay - sy * dt
+                tangential[s, i, ANCHOR, 2] = az - sz * dt
                 for j in range(3):
                     tangential[s, i, START_FORCE, j] = 0.0
                 tangential[s, i, SLIP_VELOCITY, 0] = sx
