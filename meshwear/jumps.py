@@ -31,9 +31,9 @@ in the relief above, while the vertex itself wears ``J alpha_i`` times its
 relieved penetration (:func:`counter_relief`; the counter-part's own wear is
 extrapolated in :mod:`meshwear.wear`).
 
-A jump is taken as one, two and four steps of ``J``, each from the
-penetrations the one before leaves, and advances with their Richardson
-extrapolation (second order), its error estimated from the two
+A jump is taken as one step of ``J``, two of ``J / 2`` and four of ``J / 4``
+(each from the penetrations the one before leaves) and advances with their
+Richardson extrapolation (second order), its error estimated from the two
 extrapolations (:func:`implicit`).
 """
 
@@ -256,13 +256,13 @@ def implicit(m, jump):
     (m, from the balance without a jump) and the error estimate (k,) of a
     jump of ``jump`` cycles.
 
-    Backward Euler is first order: one step, two and four steps of the
-    jump differ by errors in the ratio 4 : 2 : 1, so twice the four steps'
-    less the two's (Richardson extrapolation) is second order, as is twice
-    the two's less the one's, and the two extrapolations differ by three
-    times the error of the first: the jump advances with it and that
-    error (as embedded Runge-Kutta pairs advance with the better of their
-    two solutions). Its error grows like ``J^3``, so it allows longer jumps
+    Backward Euler is first order: the jump as one step, two and four
+    differs from the exact by errors in the ratio 4 : 2 : 1, so twice the
+    four steps' less the two's (Richardson extrapolation) is second order,
+    as is twice the two's less the one's, and the two extrapolations differ
+    by three times the error of the first: the jump advances with it and
+    that error (as embedded Runge-Kutta pairs advance with the better of
+    their two solutions). Its error grows like ``J^3``, so it allows longer jumps
     than the first-order steps' ``J^2``; the extrapolated wear is kept
     within zero and the vertex's four-step wear times two (where a vertex
     leaves the contact within the jump the steps are not smooth)."""
@@ -300,11 +300,12 @@ def counter_factors(model, state, measures, results, rates, jump, increments, t)
     relieves its wear over ``jump`` cycles, and the relative error (V,) of
     that wear: the body vertices' own factors (their jumped wear over ``jump``
     times their wear in the cycle) and error estimates carried to the counter
-    vertices under them, weighted by the counter's wear under each vertex
-    and the vertex's barycentric weights on the face it is over at ``t`` (the
-    end of the cycle). The same contact wears both, so the pressure the jump
-    relieves relieves the counter's wear as the body's; a counter vertex no
-    body vertex is over keeps its cycle's rate (factor 1)."""
+    vertices under them, weighted by each vertex's own wear in the cycle (the
+    contact's) and its barycentric weights on the face it is over at ``t``
+    (the end of the cycle). The same contact wears both, so the pressure the
+    jump relieves relieves the counter's wear as the body's; a counter vertex
+    the bodies wore but are not over at ``t`` takes the factor of the nearest
+    one they are over, and one they did not wear keeps its rate (factor 1)."""
     out = []
     for j, (surface, increment) in enumerate(zip(model.surfaces.per_vertex, increments)):
         if increment is None:
@@ -323,7 +324,12 @@ def counter_factors(model, state, measures, results, rates, jump, increments, t)
             factor = wear[index[on]] / own
             relative = estimate[index[on]] / own
             weights, corners = surface.face_weights(vertex_feet(s, j, index[on]), face[on], t)
-            share = weights * m.counter[on][:, None]
+            # each vertex weighs by its own wear in the cycle, which the same
+            # contact gave the counter too (by the counter's wear under it, a
+            # vertex that barely wore but jumps far, one just entering the
+            # contact, carried its factor to the counter's whole wear there:
+            # the gear pair's wheel wore twice the pinion's volume)
+            share = weights * own[:, None]
             for c in range(3):
                 np.add.at(weight, corners[:, c], share[:, c])
                 np.add.at(relief, corners[:, c], share[:, c] * factor)

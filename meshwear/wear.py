@@ -275,8 +275,17 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                 factors = jumps.counter_factors(model, state, measures, results, rates, jump,
                                                 increments, state.time)
             spans = _jump(model, state, before, rates, jump, results, measures, window)
+            share = None
+            if factors is not None:
+                # (the jump has moved the bodies' arrays on: the measurement's
+                # volume is from before it to the jump's start)
+                cycle = sum(float((span["wear_volume"][0] - b[2]).sum()) for span, b in
+                            zip(spans, before)) / window
+                jumped = sum(float((span["wear_volume"][1] - span["wear_volume"][0]).sum())
+                             for span in spans)
+                share = jumped / cycle if cycle > 0.0 else None
             part_spans = _jump_parts(model, parts, before_parts, part_rates, js, jump, factors,
-                                     window)
+                                     window, share)
             before_fill = time.perf_counter()
             js.filled_outputs += filled.write(
                 model, state, stop, jump, snapshots, spans, observers, check, part_spans,
@@ -561,7 +570,8 @@ def _part_limit(model, parts, part_rates, js, measures, tolerance, end, implicit
     return max(0, int(np.floor(bounds[which]))), which
 
 
-def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None, window=1):
+def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None, window=1,
+                bodies_share=None):
     """Extrapolate each worn counter-part's wear per cycle in the last
     measurement (of ``window`` resolved cycles, ``before_parts`` the arrays
     at its start) over ``jump`` more cycles, each vertex's relieved by its
@@ -569,7 +579,9 @@ def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None, 
     or None, :func:`meshwear.jumps.counter_factors`; None: explicit) (its
     vertices moved to their new depth, their faces' frames and the face
     tree renewed); return per part ``{name: (array at the jump's start, at
-    its end)}`` for depth, volume, work and vertices."""
+    its end)}`` for depth, volume, work and vertices. ``bodies_share``: the
+    bodies' jumped volume over their volume in a cycle of the measurement
+    (the part's own over the jump is its cycle's times that), or None."""
     spans = []
     for k, ((j, part), (_, volume0, work0), rate) in enumerate(
             zip(parts, before_parts, part_rates)):
@@ -580,6 +592,17 @@ def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None, 
         if factors is not None and factors[j] is not None:
             scale = jump * factors[j][0]
             relative = factors[j][1]
+            if bodies_share is not None:
+                # the same contacts wear both parts: over the jump the part
+                # wears the bodies' jumped volume times its share of it in
+                # the measurement (its factors, carried from the bodies'
+                # vertices over it at one phase, set where; a gear's wheel,
+                # most of its flanks out of mesh at that phase, outwore the
+                # pinion by a third)
+                cycle = (part.volume - volume0) / window
+                planned = float(scale @ cycle)
+                if planned > 0.0:
+                    scale = scale * (bodies_share * float(cycle.sum()) / planned)
         part.depth += scale * rate
         part.volume += scale / window * (part.volume - volume0)
         part.work += scale / window * (part.work - work0)
