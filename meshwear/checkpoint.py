@@ -99,9 +99,6 @@ def save(path, model, state, wall_time):
             arrays[f"jump_part{k}_error"] = error
             if rate is not None:
                 arrays[f"jump_part{k}_rate"] = rate
-        for k, noise in enumerate(js.part_noise):
-            if noise is not None:
-                arrays[f"jump_part{k}_noise"] = np.array(noise)
         arrays["jump_noise_var"] = np.array(list(js.noise_var) + list(js.part_noise_var))
         arrays["jump_window"] = np.array([js.window, js.relax])
         arrays["jump_history_times"] = np.array([t for t, _, _ in js.history])
@@ -192,8 +189,6 @@ def load(path, model, state):
             part_rate=[data[f"jump_part{k}_rate"].copy() if f"jump_part{k}_rate" in data
                        else None for k in range(len(worn))],
             part_error=[data[f"jump_part{k}_error"].copy() for k in range(len(worn))],
-            part_noise=[float(data[f"jump_part{k}_noise"]) if f"jump_part{k}_noise" in data
-                        else None for k in range(len(worn))],
             gap=float(gap), last_jump=int(last), jumps=int(jumps), resolved_steps=int(resolved),
             settling=bool(settling), limits=limits)
         js = state.jump

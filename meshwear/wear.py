@@ -85,8 +85,9 @@ class JumpState:
     part_error: list = field(default_factory=list)  # per worn counter-part (V,) estimated
                                                      # error of its depth (m)
     part_noise: list = field(default_factory=list)  # per worn counter-part: the sampling
-                                                     # noise of its wear per cycle (m), as
-                                                     # last measured (None: not yet)
+                                                     # noise of its wear per cycle (m) in this
+                                                     # measurement, from ``history`` (None:
+                                                     # too few; not saved: measured anew)
     part_noise_var: list = field(default_factory=list)  # per worn counter-part: the
                                                      # variance (m^2) the jumps' noise added
                                                      # to its depth (random across jumps)
@@ -316,7 +317,6 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
             # flank switching between two rates): average over more cycles,
             # and measure the noise and the drift again at that window
             following = js.window = 2 * window
-            js.part_noise = [None] * len(parts)
             js.history = []
         # cycles between the middles of this measurement and the next
         js.gap = jump + 0.5 * (window + following) + (1.0 if js.settling else 0.0)
