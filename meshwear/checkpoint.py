@@ -41,6 +41,9 @@ def input_digests(scene):
             mesh = getattr(part, "mesh", None)
             if mesh is not None:
                 out[f"{kind}[{i}].mesh ({Path(mesh).name})"] = _file_digest(Path(mesh))
+    mechanism = getattr(scene, "mechanism", None)
+    if mechanism is not None:
+        out[f"mechanism.model ({Path(mechanism.model).name})"] = _file_digest(Path(mechanism.model))
     return out
 
 
@@ -79,6 +82,9 @@ def save(path, model, state, wall_time):
             arrays[f"body{k}_{name}"] = getattr(s, name)
         arrays[f"body{k}_active"] = s.active
         arrays[f"body{k}_active_wear"] = s.active_wear
+    if model.mechanism is not None:
+        # MuJoCo's whole integration state: a resumed run continues bit for bit
+        arrays["mechanism_state"] = model.mechanism.get_state()
     for m, part in enumerate(state.parts):
         if part is not None:
             for name in _PART_ARRAYS:
@@ -169,6 +175,8 @@ def load(path, model, state):
                 for name in _PART_ARRAYS:
                     getattr(part, name)[...] = data[f"part{m}_{name}"]
                 model.surfaces.per_vertex[m].rebin()
+        if model.mechanism is not None:
+            model.mechanism.set_state(data["mechanism_state"], model, state)
     except (KeyError, ValueError) as err:
         raise SceneError(model.scene.source, "", f"{path} was written by another version of "
                          f"meshwear ({err}); run without --resume to start again") from None

@@ -16,12 +16,12 @@ from .kernels.contact import LAW_SLOTS, all_vertices, contact, make_law, rotatio
 from .kernels.counter_wear import wear_counter
 from .kernels.laws import code_of
 from .kernels.nearest import face_frames
-from .motion import BalancedMotion, FixedMotion, FreeMotion, GuidedMotion, Path, PrescribedMotion
+from .motion import (BalancedMotion, FixedMotion, FreeMotion, GuidedMotion, MechanismMotion, Path,
+                     PrescribedMotion)
 from .scene import SceneError
+from .stability import STABILITY_MARGIN, _contact_matrix, _stable_step, vertex_stiffness
 from .surfaces.base import quaternion_matrix
 
-#: fraction of the estimated stability limit accepted as the largest stable dt
-STABILITY_MARGIN = 0.9
 #: ``run.dt = "auto"`` resolves a cycle of the motion into at least this many steps
 AUTO_STEPS_PER_CYCLE = 200
 #: ... and the whole run into at least this many
@@ -115,6 +115,8 @@ class Model:
     surfaces: object = None
     cull: bool = True
     extent: float = 1.0
+    #: the MuJoCo mechanism the riders move with (:mod:`meshwear.mechanism`), or None
+    mechanism: object = None
 
     def __post_init__(self):
         steps = np.union1d(np.union1d(self.sample_steps, self.frame_steps), [self.n_steps])
@@ -255,6 +257,11 @@ def build_model(scene):
     SceneError, geometry.MeshError
         For input the engine cannot use, naming the key.
     """
+    mechanism = None
+    if scene.mechanism is not None:
+        from .mechanism import Mechanism
+
+        mechanism = Mechanism(scene)
     built = []
     for j, s in enumerate(scene.surfaces):
         try:
@@ -264,7 +271,11 @@ def build_model(scene):
             raise SceneError(scene.source, key, str(err)) from None
     # the bodies are refined where they face the surfaces, then the mesh
     # surfaces where the bodies can reach them over the run
-    bodies = _build_bodies(scene, surfaces.SurfaceSet(built))
+    if mechanism is not None:
+        for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
+            if s.mechanism_body is not None:
+                _ride(mechanism, surface, j, s.mechanism_body, 0.0)
+    bodies = _build_bodies(scene, surfaces.SurfaceSet(built), mechanism)
     for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
         if getattr(s, "resolution", None) is not None and isinstance(surface,
                                                                      surfaces.MeshSurface):
@@ -281,6 +292,12 @@ def build_model(scene):
                                  "only; set wear.jump = 'implicit' (the default)")
             surface.make_worn(code_of(s.law or scene.wear.law),
                               scene.wear.coefficient if s.coefficient is None else s.coefficient)
+    if mechanism is not None:
+        # refined or made worn: the riders anew
+        mechanism.surfaces = []
+        for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
+            if s.mechanism_body is not None:
+                _ride(mechanism, surface, j, s.mechanism_body, 0.0)
     surface_set = surfaces.SurfaceSet(built)
     plane_array = surface_set.planes
 
@@ -313,14 +330,25 @@ def build_model(scene):
     # about its axis, against the smallest active-set margin
     margin = min(surfaces.margin_of(scene, b) for b in bodies)
     for surface in surface_set.meshes:
-        surface.settle_invariance(margin)
+        if not getattr(surface, "rider", False):
+            surface.settle_invariance(margin)
     surface_set.refresh_bounds()
+    if mechanism is not None:
+        # slot order: uniform planes first
+        slot_of = {id(x): k for k, x in enumerate(surface_set.slots)}
+        mechanism.surfaces = [(x, slot_of[id(x)], name, placement)
+                              for x, _, name, placement in mechanism.surfaces]
     periods = _periods(scene)
     period = scene.wear.period or (max(periods) if periods else None)
     slots = plane_array.shape[0] + len(surface_set.per_vertex)
     limit = _stable_limit(bodies, law, slots)[0]
+    if mechanism is not None:
+        limit = min(limit, mechanism.stable_limit(bodies, law, slots)[0])
+        limit = min(limit, mechanism.file_timestep) if scene.run.dt == "auto" else limit
     dt, n_steps, cycle_steps = _timing(scene, period, limit)
     law[LAW_SLOTS.index("dt")] = dt
+    if mechanism is not None:
+        mechanism.set_timestep(dt)
     for key in ("frames", "history"):
         if getattr(run, key) > n_steps + 1:
             # a short run (a trial, a --set run.duration) writes at every step
@@ -333,14 +361,34 @@ def build_model(scene):
                  surfaces=surface_set,
                  quasi_static=quasi_static, dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
                  frame_steps=_even_steps(n_steps, run.frames), period=period,
-                 cycle_steps=cycle_steps)
+                 cycle_steps=cycle_steps, mechanism=mechanism,
+                 # a mechanism's motion is not known ahead: every vertex is checked each step
+                 cull=mechanism is None)
 
 
-def _build_bodies(scene, surface_set):
+def _ride(mechanism, surface, index, name, t):
+    """Put counter-surface ``surface`` on mechanism body ``name``: its rest
+    frame becomes its placement in that body's frame, its motion a steady
+    turn and velocity rewritten at every step (:mod:`meshwear.mechanism`)."""
+    from .kernels.rigid import STEADY
+
+    m = surface.motion
+    if not getattr(surface, "rider", False):
+        surface.placement = (m.R0.copy(), m.position.copy())
+        m.path.terms = np.zeros((1, 9))
+        m.path.terms[0, 0] = STEADY
+        surface.rider = True
+        surface.invariant = False
+        surface._compiled = None
+    mechanism.surface_motion(name, *surface.placement, t, m.array, m.path.terms)
+    mechanism.surfaces.append((surface, index, name, surface.placement))
+
+
+def _build_bodies(scene, surface_set, mechanism=None):
     bodies = []
     for j, b in enumerate(scene.bodies):
         try:
-            bodies.append(_build_body(scene, j, b, surface_set))
+            bodies.append(_build_body(scene, j, b, surface_set, mechanism))
         except geometry.MeshError as err:
             # the mesh loader names the mesh file; add the scene file and the key
             key = f"body[{j}].mesh" if b.mesh is not None else f"body[{j}].shape"
@@ -364,7 +412,7 @@ def _surface_faces_to_refine(scene, surface, bodies):
     moves too fast to sample."""
     from scipy.spatial import cKDTree
 
-    if any(b.motion.dynamic_axes == "all" for b in bodies):
+    if any(b.motion.dynamic_axes == "all" for b in bodies) or getattr(surface, "rider", False):
         return None
     periods = {round(p, 12) for p in _periods(scene)}
     window = scene.run.duration
@@ -484,19 +532,24 @@ def _even_steps(n_steps, count):
     return np.unique(np.rint(np.linspace(0, n_steps, count)).astype(np.int64))
 
 
-def _build_body(scene, index, body, surface_set):
+def _build_body(scene, index, body, surface_set, mechanism=None):
     key = f"body[{index}]"
     vertices, faces = geometry.load_part(body)
     refinement = None
     if body.resolution is not None:
         vertices, faces, refinement = remesh.refine_part(
             body, vertices, faces, _faces_to_refine(scene, body, vertices, faces, surface_set))
-    needs_inertia = body.motion in ("free", "guided")
+    needs_inertia = body.motion in ("free", "guided", "mechanism")
     area = geometry.tributary_areas(vertices, faces)
+    riding = body.motion == "mechanism"
     try:
         mass, com, inertia = geometry.mass_properties(
             vertices, faces, density=body.density, mass=body.mass,
             source=str(body.mesh) if body.mesh is not None else f"{key}.shape")
+        if riding:
+            # MuJoCo's mass, the mesh's distribution of it (the stability limit)
+            scale = mechanism.mass(body.mechanism_body) / mass
+            mass, inertia = mass * scale, inertia * scale
     except geometry.MeshError:
         if needs_inertia:
             raise
@@ -532,6 +585,10 @@ def _build_body(scene, index, body, surface_set):
         motion = GuidedMotion(pose[0:3].copy(), path, body.path.free_axis, mass, acceleration)
     elif body.motion == "prescribed":
         motion = PrescribedMotion(pose[0:3].copy(), path)
+    elif riding:
+        motion = MechanismMotion(mass, inertia)
+        mechanism.bodies.append((None, index, body.mechanism_body, pose.copy()))
+        mechanism.body_pose(body.mechanism_body, pose.copy(), pose)
     else:
         motion = FixedMotion()
     turning = body.path is not None and body.path.rotation is not None
@@ -549,7 +606,7 @@ def _build_body(scene, index, body, surface_set):
         mass=float(mass), inertia=inertia, origin=-com, initial_pose=pose, motion=motion,
         period=path.period, radius=float(np.linalg.norm(body_vertices, axis=1).max()),
         depth_limit=(IMPACT_DEPTH * _thinnest(body_vertices)
-                     if motion.dynamic_axes is not None else 0.0),
+                     if motion.dynamic_axes is not None and not riding else 0.0),
         refinement=refinement)
 
 
@@ -573,7 +630,8 @@ def _faces_to_refine(scene, body, vertices, faces, surface_set):
     face); of a guided, prescribed or fixed one (which only translates) the
     faces that face a surface within :data:`REFINE_REACH` of its size at the
     start (its path's displacement included); all of one that turns."""
-    if body.motion == "free" or (body.path is not None and body.path.rotation is not None):
+    if body.motion in ("free", "mechanism") or (body.path is not None
+                                                and body.path.rotation is not None):
         return None
     R = np.array(rotation_entries(np.asarray(body.orientation, float))).reshape(3, 3)
     points = vertices @ R.T + np.asarray(body.position, float) + Path(body.path).displacement(0.0)
@@ -625,6 +683,8 @@ def initial_state(model):
         if part is not None:
             m.attach(part)
     state = State(time=0.0, step=0, bodies=bodies, parts=parts)
+    if model.mechanism is not None:
+        model.mechanism.reset(model, state)
     for body, s in zip(model.bodies, state.bodies):
         surfaces.update(model, body, s, 0.0)
     if model.quasi_static:
@@ -681,7 +741,10 @@ def stable_time_step(model):
     times :data:`STABILITY_MARGIN`. Returns ``(inf, None)`` when no body is
     integrated in time.
     """
-    return _stable_limit(model.bodies, model.law, model.slots)
+    limit = _stable_limit(model.bodies, model.law, model.slots)
+    if model.mechanism is not None:
+        limit = min(limit, model.mechanism.stable_limit(model.bodies, model.law, model.slots))
+    return limit
 
 
 def _stable_limit(bodies, law, slots):
@@ -690,13 +753,11 @@ def _stable_limit(bodies, law, slots):
     best, who = np.inf, None
     for b in bodies:
         kind = b.motion.dynamic_axes
-        if kind is None:
-            continue
-        a = b.area_vectors[:, 3]
-        c, d, ct, dtan = (law[5 + 2 * j] + law[6 + 2 * j] * a for j in range(4))  # LAW_SLOTS
+        if kind is None or isinstance(b.motion, MechanismMotion):
+            continue        # a mechanism's riders: Mechanism.stable_limit
         # a vertex may press on every plane at once (a box in a corner)
         planes = max(1, slots)
-        k, d = planes * np.maximum(c, ct), planes * np.maximum(d, dtan)
+        k, d = (planes * x for x in vertex_stiffness(b, law))
         if kind == "axis":
             K = np.array([[k.sum()]])
             C = np.array([[d.sum()]])
@@ -744,34 +805,3 @@ def check_time_step(model):
     return limit
 
 
-def _contact_matrix(weights, r):
-    """sum_i w_i J_i^T J_i (6, 6) for J_i = [I, -[r_i]x]."""
-    out = np.zeros((6, 6))
-    w = weights.sum()
-    out[:3, :3] = w * np.eye(3)
-    wr = weights @ r
-    skew = np.array([[0.0, -wr[2], wr[1]], [wr[2], 0.0, -wr[0]], [-wr[1], wr[0], 0.0]])
-    out[:3, 3:] = -skew
-    out[3:, :3] = skew
-    out[3:, 3:] = np.einsum("i,i", weights, (r * r).sum(1)) * np.eye(3) - np.einsum("i,ij,ik->jk", weights, r, r)
-    return out
-
-
-def _stable_step(K, C, M):
-    """Smallest per-mode stability limit of the damped oscillator M x'' + C x' + K x = 0."""
-    w, U = np.linalg.eigh(M)
-    S = U @ np.diag(w ** -0.5) @ U.T
-    lam, phi = np.linalg.eigh(S @ K @ S)
-    Ct = S @ C @ S
-    best = np.inf
-    for j in range(len(lam)):
-        if lam[j] <= 0.0:
-            continue
-        omega = np.sqrt(lam[j])
-        zeta = phi[:, j] @ Ct @ phi[:, j] / (2.0 * omega)
-        best = min(best, 2.0 * (np.sqrt(1.0 + zeta * zeta) - zeta) / omega)
-    # a damping-dominated mode: b = c dt / m <= 2
-    c_max = np.linalg.eigvalsh(Ct).max()
-    if c_max > 0.0:
-        best = min(best, 2.0 / c_max)
-    return best

@@ -215,3 +215,23 @@ class FixedMotion(Motion):
     """The body does not move."""
 
     kind = FIXED
+
+
+class MechanismMotion(Motion):
+    """A part riding on a body of a MuJoCo mechanism (:mod:`meshwear.mechanism`):
+    MuJoCo sets its pose and velocity before every step, the compiled loop
+    leaves them (kind ``FIXED``, whose step does not move it). ``mass`` and
+    ``inertia`` (MuJoCo's mass, distributed as the mesh's) bound the stable
+    contact step; the joints only add to the mass a contact mode moves."""
+
+    kind = FIXED
+    dynamic_axes = "all"
+
+    def __init__(self, mass, inertia):
+        super().__init__(mass=mass, inertia=np.asarray(inertia, float))
+
+    def place(self, pose, t):
+        """The mechanism places it (:meth:`meshwear.mechanism.Mechanism.place`)."""
+
+    def advance(self, pose, wrench, t, dt):
+        """The mechanism moves it."""

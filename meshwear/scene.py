@@ -38,7 +38,7 @@ JUMPS = ("implicit", "explicit")
 UNITS = ("m", "mm", "cm", "um", "in")
 #: how a part's frames are written: a .pvd collection of .vtp files, or one VTKHDF file
 SERIES = ("pvd", "vtkhdf")
-MOTIONS = ("free", "guided", "prescribed", "fixed")
+MOTIONS = ("free", "guided", "prescribed", "fixed", "mechanism")
 SURFACE_TYPES = ("plane", "mesh", "cylinder", "sphere")
 SIDES = ("outside", "inside")
 #: keys of each primitive shape besides ``type``, and the required ones
@@ -47,11 +47,12 @@ SHAPE_KEYS = {"box": ("size",), "sphere": ("radius", "subdivisions"),
 SHAPE_REQUIRED = {"box": ("size",), "sphere": ("radius",), "cylinder": ("radius", "height")}
 #: keys of each ``[[surface]]`` type besides ``name`` and ``type``
 SURFACE_KEYS = {
-    "plane": ("point", "normal", "size", "rotation", "path"),
+    "plane": ("point", "normal", "size", "rotation", "path", "mechanism_body"),
     "mesh": ("mesh", "shape", "units", "resolution", "position", "orientation", "rotation",
-             "path", "smooth_normals", "wear", "law", "coefficient"),
-    "cylinder": ("radius", "axis", "point", "length", "side", "rotation", "path"),
-    "sphere": ("radius", "center", "side", "rotation", "path"),
+             "path", "smooth_normals", "wear", "law", "coefficient", "mechanism_body"),
+    "cylinder": ("radius", "axis", "point", "length", "side", "rotation", "path",
+                 "mechanism_body"),
+    "sphere": ("radius", "center", "side", "rotation", "path", "mechanism_body"),
 }
 #: largest scene file read (bytes)
 MAX_SCENE_BYTES = 16 * 2**20
@@ -334,6 +335,37 @@ class RotationConfig:
 
 
 @dataclass(frozen=True, kw_only=True)
+class MechanismConfig:
+    """``[mechanism]``: the MuJoCo model (an MJCF or URDF file, resolved
+    against the scene's folder) whose bodies carry the parts that name a
+    ``mechanism_body`` (docs/model.md, "Mechanisms"). MuJoCo integrates its
+    joints, actuators, springs and gravity; meshwear adds the contact forces
+    of the worn parts. ``keyframe`` names the MJCF keyframe to start from
+    (else the model's reference pose at rest); ``controls`` holds actuator
+    inputs constant over the run, by actuator name (a force, a target speed:
+    what the actuator's MJCF type takes)."""
+
+    model: Path
+    keyframe: str | None = None
+    controls: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        if not isinstance(self.model, Path):
+            raise SceneError("", "model", f'expected the path of an MJCF file, got {_show(self.model)}')
+        if not self.model.is_file():
+            why = "a folder, not a file" if self.model.is_dir() else "file not found"
+            raise SceneError("", "model", f"{self.model}: {why}")
+        if self.keyframe is not None and not isinstance(self.keyframe, str):
+            raise SceneError("", "keyframe", f"expected a keyframe name, got {_show(self.keyframe)}")
+        if not isinstance(self.controls, dict):
+            raise SceneError("", "controls", "expected a table of actuator names and inputs, "
+                             f"e.g. {{ drive = 10.0 }}, got {_show(self.controls)}")
+        for name, value in self.controls.items():
+            if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+                raise SceneError("", f"controls.{name}", f"expected a finite number, got {_show(value)}")
+
+
+@dataclass(frozen=True, kw_only=True)
 class BodyConfig:
     """``[[body]]``: a worn rigid body.
 
@@ -343,6 +375,10 @@ class BodyConfig:
     normalised. ``guided`` bodies need a path with ``free_axis``;
     ``prescribed`` ones a path without it; ``free`` and ``fixed`` ones no path.
     Velocities and ``force`` do not apply to prescribed and fixed bodies.
+    ``mechanism_body`` names the body of the ``[mechanism]`` model the part
+    rides on (its motion is then ``"mechanism"``, from MuJoCo, with MuJoCo's
+    mass); ``position`` and ``orientation`` then place the mesh in that
+    body's frame.
     """
 
     name: str
@@ -359,10 +395,25 @@ class BodyConfig:
     force: tuple = (0.0, 0.0, 0.0)
     motion: str = "free"
     path: PathConfig | None = None
+    mechanism_body: str | None = None
 
     def __post_init__(self):
         _set(self, "name", _name)
         _check_mesh_or_shape(self)
+        _check_rider(self, ("path",))
+        if self.mechanism_body is not None:
+            if self.motion == "free":       # the default: the mechanism moves it
+                object.__setattr__(self, "motion", "mechanism")
+            elif self.motion != "mechanism":
+                raise SceneError("", "motion", f"{self.motion!r}: a part on mechanism body "
+                                 f"{self.mechanism_body!r} moves with it; leave motion out")
+            for key in ("velocity", "angular_velocity", "force"):
+                if any(getattr(self, key)):
+                    raise SceneError("", key, f"does not apply to a part on mechanism body "
+                                     f"{self.mechanism_body!r} (MuJoCo moves it)")
+        elif self.motion == "mechanism":
+            raise SceneError("", "mechanism_body", "missing; motion = 'mechanism' needs the "
+                             "name of the [mechanism] body the part rides on")
         _exclusive(self, "density", "mass")
         _set_optional(self, "density", _positive)
         _set_optional(self, "mass", _positive)
@@ -443,10 +494,13 @@ class SurfaceConfig:
     wear: bool = False
     law: str | None = None
     coefficient: float | str | None = None
+    #: the [mechanism] body it rides on (its motion then comes from MuJoCo)
+    mechanism_body: str | None = None
 
     def __post_init__(self):
         _set(self, "name", _name)
         _set(self, "type", _choice, SURFACE_TYPES)
+        _check_rider(self, ("path", "rotation"))
         _set(self, "smooth_normals", _boolean)
         _set_optional(self, "rotation", _instance, RotationConfig)
         _set_optional(self, "path", _instance, PathConfig)
@@ -500,6 +554,19 @@ class SurfaceConfig:
                                  f"{_show(self.axis)}; give it a length to tumble it")
 
 
+def _check_rider(obj, moves):
+    """A part on a mechanism body takes its motion from MuJoCo only."""
+    if obj.mechanism_body is None:
+        return
+    if not isinstance(obj.mechanism_body, str) or not obj.mechanism_body:
+        raise SceneError("", "mechanism_body", f"expected a body name of the [mechanism] "
+                         f"model, got {_show(obj.mechanism_body)}")
+    for key in moves:
+        if getattr(obj, key) is not None:
+            raise SceneError("", key, f"does not apply to a part on mechanism body "
+                             f"{obj.mechanism_body!r}: MuJoCo moves it")
+
+
 def _cross_norm(a, b):
     """|a x b| of two unit vectors (0 when parallel)."""
     return math.hypot(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
@@ -522,6 +589,8 @@ class Scene:
     wear: WearConfig = field(default_factory=WearConfig)
     bodies: tuple = ()
     surfaces: tuple = ()
+    #: the MuJoCo model the parts with a ``mechanism_body`` ride on
+    mechanism: MechanismConfig | None = None
     #: (key, value) pairs set over the file's (``--set``), part of its identity
     overrides: tuple = ()
     #: the parsed TOML it was built from (None if built in code): :meth:`set` edits a copy
@@ -579,6 +648,22 @@ class Scene:
                 if b.motion == "free":
                     fail(f"body[{i}].motion", "'free' is not allowed with run.mode = "
                          "'quasi-static'; use guided, prescribed or fixed")
+        riders = [(f"{kind}[{i}]", x) for kind, group in (("body", self.bodies),
+                                                          ("surface", self.surfaces))
+                  for i, x in enumerate(group) if x.mechanism_body is not None]
+        if riders and self.mechanism is None:
+            fail(riders[0][0] + ".mechanism_body", "there is no [mechanism] table; add one "
+                 'with model = "file.xml" (a MuJoCo model)')
+        if self.mechanism is not None:
+            if not riders:
+                fail("mechanism", "no part rides on it; give a body or surface a "
+                     "mechanism_body")
+            if self.run.mode == "quasi-static":
+                fail("run.mode", "'quasi-static' does not apply to a scene with a "
+                     "[mechanism]: MuJoCo integrates it in time; use 'dynamic'")
+            if self.wear.acceleration == "cycle_jump":
+                fail("wear.acceleration", "'cycle_jump' does not apply to a scene with a "
+                     "[mechanism] yet; use 'none'")
         if self.wear.acceleration == "cycle_jump" and self.wear.period is None and not any(
                 (x.path is not None and x.path.periodic)
                 or (getattr(x, "rotation", None) is not None and x.rotation.rate != 0.0)
@@ -790,7 +875,8 @@ def parse_scene(data: dict, source: str = "<scene>", base_dir: Path = Path("."))
         _check_format(data["format"])
     except SceneError as err:
         raise SceneError(source, err.key, err.message) from None
-    _check_keys(source, data, "", ("format", "run", "contact", "wear", "body", "surface"))
+    _check_keys(source, data, "",
+                ("format", "run", "contact", "wear", "body", "surface", "mechanism"))
     tables = {name: _simple(cls, data.get(name, {}), name, source)
               for name, cls in (("run", RunConfig), ("contact", ContactConfig), ("wear", WearConfig))}
     bodies = _array(source, data.get("body", []), "body")
@@ -799,8 +885,15 @@ def parse_scene(data: dict, source: str = "<scene>", base_dir: Path = Path("."))
     bodies = [_body(source, base_dir, raw, f"body[{i}]") for i, raw in enumerate(bodies)]
     surfaces = [_surface(source, base_dir, raw, f"surface[{j}]")
                 for j, raw in enumerate(_array(source, data.get("surface", []), "surface"))]
+    mechanism = None
+    if "mechanism" in data:
+        table = _table(source, data["mechanism"], "mechanism", MechanismConfig)
+        if isinstance(table.get("model"), str):
+            table["model"] = base_dir / table["model"]
+        mechanism = _build(MechanismConfig, source, "mechanism", table)
     return Scene(format=data["format"], source=source, base_dir=base_dir, bodies=tuple(bodies),
-                 surfaces=tuple(surfaces), data=copy.deepcopy(data), **tables)
+                 surfaces=tuple(surfaces), mechanism=mechanism, data=copy.deepcopy(data),
+                 **tables)
 
 
 def _array(source, value, key):
@@ -895,6 +988,13 @@ def _geometry(source, base_dir, table, prefix):
 
 def _body(source, base_dir, value, prefix):
     table = _geometry(source, base_dir, _table(source, value, prefix, BodyConfig), prefix)
+    if isinstance(value, dict) and "mechanism_body" in value:
+        for key in ("motion", "density", "mass"):
+            if key in value:
+                why = ("MuJoCo moves it" if key == "motion"
+                       else "its mass is the MuJoCo body's")
+                raise SceneError(source, f"{prefix}.{key}", "does not apply to a part on "
+                                 f"mechanism body {value['mechanism_body']!r}: {why}")
     return _build(BodyConfig, source, prefix, table)
 
 

@@ -34,10 +34,17 @@ class NumericalError(RuntimeError):
 def step(model, state):
     """Advance ``state`` by one time step of ``model``, in place: the Python
     reference of the compiled loop (:func:`advance` uses that)."""
-    for body, s in zip(model.bodies, state.bodies):
-        step_body(model, body, s, state.step)
+    if model.mechanism is not None:
+        model.mechanism.step(model, state, state.step, partial(_step_bodies, model, state))
+    else:
+        _step_bodies(model, state, state.step)
     state.step += 1
     state.time = state.step * model.dt
+
+
+def _step_bodies(model, state, k):
+    for body, s in zip(model.bodies, state.bodies):
+        step_body(model, body, s, k)
 
 
 def step_body(model, body, s, k):

@@ -35,8 +35,13 @@ def _motion_arrays(model, body, s):
 
 def advance(model, state, until):
     """Step every body of ``state`` from ``state.step`` to step ``until``
-    (bodies that share a worn counter-surface in turn, a step each)."""
-    if model.worn_counters and len(model.bodies) > 1:
+    (bodies that share a worn counter-surface in turn, a step each; with a
+    mechanism, a step at a time, MuJoCo's step around the bodies')."""
+    if model.mechanism is not None:
+        for k in range(state.step, until):
+            model.mechanism.step(model, state, k,
+                                 lambda k: _advance_bodies(model, state, k, k + 1))
+    elif model.worn_counters and len(model.bodies) > 1:
         for k in range(state.step, until):
             _advance_bodies(model, state, k, k + 1)
     else:

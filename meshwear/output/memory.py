@@ -11,7 +11,8 @@ class MemoryHistory:
     After a run, ``rows[name]`` is a dict of arrays per body: ``time``,
     ``pose`` (k, 13), ``origin`` (k, 3), ``wrench`` (k, 6), ``friction_work``,
     ``wear_volume``, ``max_wear_depth``, ``wear_depth`` (k, n) and
-    ``contact_points``.
+    ``contact_points``; with a mechanism, its joint and actuator columns
+    (``spin.v``, ``press.force``: docs/outputs.md).
     """
 
     def __init__(self):
@@ -34,6 +35,9 @@ class MemoryHistory:
             r["contact_points"].append(q["contact_points"])
             r["active"].append(len(s.active))
             r["resolved"].append(bool(state.resolved))
+            if model.mechanism is not None:
+                for key, value in model.mechanism.joints().items():
+                    r.setdefault(key, []).append(value)
 
     def on_frame(self, model, state):
         pass

@@ -119,6 +119,18 @@ class SurfaceSet:
             self._list_tuples = tuples
         return self._list
 
+    def mechanism_moved(self, t):
+        """Surfaces on a mechanism body had their motion rewritten
+        (:meth:`meshwear.mechanism.Mechanism.place`): copy it where the
+        kernels read it, and put the planes at ``t``."""
+        compiled = getattr(self, "_compiled_planes", None)
+        for j, s in enumerate(self.slots):
+            if getattr(s, "rider", False):
+                self.terms[j, :1] = s.motion.terms
+                if j < len(self.uniform) and compiled is not None:
+                    compiled[1][j] = s.motion.array
+        self.set_planes(t)
+
     def set_planes(self, t):
         """Put the moving uniform planes where they are at ``t``."""
         if self.moving_planes:

@@ -176,6 +176,8 @@ class CounterSurface:
     def describe(self):
         """How it moves, in a few words (``meshwear check``)."""
         m = self.motion
+        if getattr(self, "rider", False):
+            return "on a mechanism body (MuJoCo moves it)"
         if self.static:
             return "fixed"
         parts = []

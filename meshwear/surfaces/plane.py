@@ -46,8 +46,8 @@ class Plane(CounterSurface):
         return self._bounds(projection=np.outer(self.normal, self.normal), normal=self.normal)
 
     def describe(self):
-        if self.static:
-            return "fixed"
+        if getattr(self, "rider", False) or self.static:
+            return super().describe()
         parts = []
         if self.motion.rate:
             parts.append(f"turning about its normal at {self.motion.rate:g} rad/s")

@@ -1,0 +1,392 @@
+"""Mechanisms: worn parts riding on the bodies of a MuJoCo model.
+
+MuJoCo (the ``mujoco`` package, optional extra ``meshwear[mechanism]``)
+integrates the mechanism: joints, actuators, springs, gravity and its own
+contacts. meshwear keeps the contact of each worn part with its
+counter-surfaces, friction, wear and the evolving geometry. A step of
+``dt`` (docs/model.md, "Mechanisms"):
+
+1. the parts are where MuJoCo has their bodies at ``t`` (pose and velocity of
+   each body's frame, the part placed in it by its ``position`` and
+   ``orientation``);
+2. MuJoCo's position and velocity stages (``mj_step1``);
+3. meshwear's contact step of every worn body (normal force, friction, wear);
+4. the contact wrench on each body and, reversed, on each counter-surface,
+   applied to their MuJoCo bodies (``xfrc_applied``, at their centres of mass);
+5. MuJoCo's force stage and its integration to ``t + dt`` (``mj_step2``),
+   then its kinematics there, which place the parts for the next step.
+
+This is the dynamics seam for parts moved by a multibody engine: poses and
+velocities out (:meth:`Mechanism.place`), wrenches in (:meth:`Mechanism.push`).
+meshwear's own motions (:mod:`meshwear.motion`) move the other parts in the
+compiled loop; a part on a mechanism body has the motion kind ``FIXED``
+there, so the loop never moves it between two placings.
+"""
+
+import itertools
+
+import numpy as np
+
+from .kernels.mechanism import slot_wrench as _slot_wrench
+from .kernels.rigid import STEADY
+from .scene import SceneError
+from .stability import STABILITY_MARGIN, _contact_matrix, _stable_step, vertex_stiffness
+from .surfaces.base import quaternion_matrix
+
+
+def _mujoco(source):
+    try:
+        import mujoco
+    except ImportError:
+        raise SceneError(source, "mechanism", "needs the mujoco package, the optional "
+                         "mechanism extra: pip install 'meshwear[mechanism]'") from None
+    return mujoco
+
+
+def _first_line(err):
+    text = str(err).strip().splitlines()
+    return " ".join(line.strip() for line in text[:2]) if text else type(err).__name__
+
+
+def _quaternion_product(a, b):
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+                     w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+
+
+def _cross(a, b):
+    """a x b of two 3-vectors (np.cross costs 20 µs a call)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])
+
+
+def _turn(axis, angle):
+    x, y, z = axis
+    c, s = np.cos(angle), np.sin(angle)
+    K = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+
+
+class Mechanism:
+    """A compiled MuJoCo model and its data, and which meshwear parts ride
+    on which of its bodies.
+
+    Parameters
+    ----------
+    scene : meshwear.scene.Scene
+        With a ``[mechanism]`` table.
+
+    Raises
+    ------
+    SceneError
+        A missing ``mujoco``, a model MuJoCo cannot read or compile (its
+        first line), a ``mechanism_body`` it does not have, or the RK4
+        integrator (its step cannot be split for the contact forces).
+    """
+
+    def __init__(self, scene):
+        mujoco = self.mujoco = _mujoco(scene.source)
+        path = scene.mechanism.model
+        self.source = scene.source
+        try:
+            spec = mujoco.MjSpec.from_file(str(path))
+        except Exception as err:   # mujoco raises ValueError with the parser's text
+            raise SceneError(scene.source, "mechanism.model",
+                             f"{path.name}: MuJoCo cannot read it: {_first_line(err)}") from None
+        names = [b.name for b in spec.bodies]
+        riders = [(f"body[{i}]", b) for i, b in enumerate(scene.bodies)]
+        riders += [(f"surface[{j}]", s) for j, s in enumerate(scene.surfaces)]
+        riders = [(key, x) for key, x in riders if x.mechanism_body is not None]
+        for key, x in riders:
+            if x.mechanism_body not in names or x.mechanism_body == "world":
+                shown = ", ".join(repr(n) for n in names if n and n != "world") or "none"
+                raise SceneError(scene.source, f"{key}.mechanism_body",
+                                 f"{x.mechanism_body!r} is not a moving body of {path.name} "
+                                 f"(its bodies: {shown})")
+        # MuJoCo's own collisions between the bodies meshwear handles are
+        # meshwear's to compute: excluded
+        handled = sorted({x.mechanism_body for _, x in riders})
+        for a, b in itertools.combinations(handled, 2):
+            exclude = spec.add_exclude()
+            exclude.bodyname1, exclude.bodyname2 = a, b
+        try:
+            self.model = spec.compile()
+        except Exception as err:
+            raise SceneError(scene.source, "mechanism.model",
+                             f"{path.name}: MuJoCo cannot compile it: {_first_line(err)}") from None
+        m = self.model
+        if m.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4:
+            raise SceneError(scene.source, "mechanism.model",
+                             f"{path.name}: the RK4 integrator cannot take meshwear's contact "
+                             "forces within its step; use Euler, implicit or implicitfast")
+        #: the timestep of the MJCF file (s), before meshwear sets its own
+        self.file_timestep = float(m.opt.timestep)
+        config = scene.mechanism
+        self.keyframe = None
+        if config.keyframe is not None:
+            keys = [m.key(k).name for k in range(m.nkey)]
+            if config.keyframe not in keys:
+                raise SceneError(scene.source, "mechanism.keyframe",
+                                 f"{config.keyframe!r} is not a keyframe of {path.name} "
+                                 f"(its keyframes: {', '.join(map(repr, keys)) or 'none'})")
+            self.keyframe = keys.index(config.keyframe)
+        actuators = [m.actuator(a).name for a in range(m.nu)]
+        self.controls = []
+        for name, value in config.controls.items():
+            if name not in actuators:
+                raise SceneError(scene.source, f"mechanism.controls.{name}",
+                                 f"{name!r} is not an actuator of {path.name} (its actuators: "
+                                 f"{', '.join(map(repr, actuators)) or 'none'})")
+            self.controls.append((actuators.index(name), float(value)))
+        self.data = mujoco.MjData(m)
+        self._start()
+        self.ids = {name: m.body(name).id for name in handled}
+        self.path = path
+        #: (part, state index, MuJoCo body id, placement) of the riders, set by the model
+        self.bodies, self.surfaces = [], []
+        self._velocity, self._wrench = np.zeros(6), np.zeros(6)
+
+    # ------------------------------------------------------------ set-up
+    def set_timestep(self, dt):
+        self.model.opt.timestep = float(dt)
+
+    def mass(self, name):
+        """Mass (kg) of MuJoCo body ``name``."""
+        return float(self.model.body_mass[self.ids[name]])
+
+    def frame(self, name):
+        """World rotation (3, 3), origin, velocity of the origin and angular
+        velocity of the frame of MuJoCo body ``name``, as MuJoCo's last
+        kinematics left them."""
+        mujoco, m, d = self.mujoco, self.model, self.data
+        i = self.ids[name]
+        mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_XBODY, i, self._velocity, 0)
+        return (d.xmat[i].reshape(3, 3).copy(), d.xpos[i].copy(), self._velocity[3:6].copy(),
+                self._velocity[0:3].copy())
+
+    def jacobian(self, name, point):
+        """(6, nv) velocity of ``point`` (world) moving with body ``name``,
+        and the body's angular velocity, per joint velocity."""
+        J = np.zeros((6, self.model.nv))
+        self.mujoco.mj_jac(self.model, self.data, J[0:3], J[3:6], np.asarray(point, float),
+                           self.ids[name])
+        return J
+
+    def stable_limit(self, bodies, law, slots):
+        """Largest stable step (s) of the riders' contacts in the mechanism,
+        and the body that sets it: as :func:`meshwear.model.stable_time_step`
+        but in the mechanism's joint space, ``K = sum J^T K_c J`` over every
+        rider and every surface it may press on (``J`` the rider's motion
+        relative to the surface's body; the world for a surface not on the
+        mechanism) against MuJoCo's joint-space mass matrix at the start. A
+        joint takes away modes, so this is larger than the free body's."""
+
+        m, d = self.model, self.data
+        if not self.bodies or m.nv == 0:
+            return np.inf, None
+        K, C = np.zeros((m.nv, m.nv)), np.zeros((m.nv, m.nv))
+        on = [name for _, _, name, _ in self.surfaces]
+        fixed = max(0, slots - len(on))
+        for _, index, name, _ in self.bodies:
+            b = bodies[index]
+            pose = b.initial_pose
+            r = b.reference_vertices @ quaternion_matrix(pose[3:7]).T
+            k, c = vertex_stiffness(b, law)
+            Kb, Cb = _contact_matrix(k, r), _contact_matrix(c, r)
+            Jb = self.jacobian(name, pose[0:3])
+            for J in [Jb - self.jacobian(s, pose[0:3]) for s in on] + [Jb] * max(fixed, 1 - len(on)):
+                K += J.T @ Kb @ J
+                C += J.T @ Cb @ J
+        M = np.zeros((m.nv, m.nv))
+        try:
+            self.mujoco.mj_fullM(m, d, M)          # MuJoCo 4
+        except TypeError:
+            self.mujoco.mj_fullM(m, M, d.qM)       # MuJoCo 3
+        moved = np.flatnonzero(np.abs(K).sum(axis=0) > 0.0)
+        if not len(moved):
+            return np.inf, None
+        # the joints no contact moves stay out (their modes are MuJoCo's),
+        # their inertia in: the moved joints' mass is the Schur complement
+        rest = np.setdiff1d(np.arange(m.nv), moved)
+        Ma = M[np.ix_(moved, moved)]
+        if len(rest):
+            Mab = M[np.ix_(moved, rest)]
+            Ma = Ma - Mab @ np.linalg.solve(M[np.ix_(rest, rest)], Mab.T)
+        sub = np.ix_(moved, moved)
+        dt = _stable_step(K[sub], C[sub], Ma)
+        return STABILITY_MARGIN * dt, bodies[self.bodies[0][1]].name
+
+    def describe(self, model):
+        """Lines for ``meshwear check``: the MuJoCo model, its joints and
+        actuators, the parts meshwear handles on its bodies, the two
+        stability limits."""
+        m = self.model
+        mujoco = self.mujoco
+        kinds = {int(v): k.removeprefix("mjJNT_").lower()
+                 for k, v in mujoco.mjtJoint.__members__.items()}
+        joints = ", ".join(f"{m.joint(j).name or j} ({kinds.get(int(m.jnt_type[j]), '?')})"
+                           for j in range(m.njnt)) or "none"
+        actuators = ", ".join(m.actuator(a).name or str(a) for a in range(m.nu)) or "none"
+        riders = {}
+        for _, i, name, _ in self.bodies:
+            riders.setdefault(name, []).append(model.bodies[i].name)
+        for surface, _, name, _ in self.surfaces:
+            riders.setdefault(name, []).append(surface.name)
+        lines = [f"mechanism {self.path.name}: {m.nbody - 1} bodies, {m.njnt} joints "
+                 f"[{joints}], actuators [{actuators}]"]
+        for name, parts in riders.items():
+            lines.append(f"  body {name!r} ({self.mass(name):.6g} kg) carries "
+                         + ", ".join(repr(p) for p in parts))
+        contact, _ = self.stable_limit(model.bodies, model.law, model.slots)
+        lines.append(f"  MuJoCo timestep in the file {self.file_timestep:.3g} s; the coupled "
+                     f"step {model.dt:.3g} s; the riders' contact in the joints is stable up to "
+                     f"{contact:.3g} s")
+        return lines
+
+    # ------------------------------------------------------------ coupling
+    def body_pose(self, name, placement, out=None):
+        """The (13,) pose of a part placed at ``placement`` (its pose in the
+        frame of body ``name``: centre of mass and orientation) in the world."""
+        R, origin, v, w = self.frame(name)
+        q = self.data.xquat[self.ids[name]]
+        out = np.zeros(13) if out is None else out
+        arm = R @ placement[0:3]
+        out[0:3] = origin + arm
+        out[3:7] = _quaternion_product(q, placement[3:7])
+        out[3:7] /= np.linalg.norm(out[3:7])
+        out[7:10] = v + _cross(w, arm)
+        out[10:13] = w
+        return out
+
+    def surface_motion(self, name, R_c, p_c, t, array, terms):
+        """Write a surface's motion (``array`` (19,), ``terms`` (1, 9)) so
+        its frame at ``t``, and its velocity field about it, are those of
+        body ``name`` with the surface placed in it at ``R_c``, ``p_c``: a
+        steady turn at the body's angular velocity and a steady velocity
+        (:mod:`meshwear.kernels.frames`)."""
+        R, origin, v, w = self.frame(name)
+        arm = R @ p_c
+        place, velocity = origin + arm, v + _cross(w, arm)
+        rate = float(np.linalg.norm(w))
+        axis = w / rate if rate > 0.0 else np.array([0.0, 0.0, 1.0])
+        array[0:9] = (_turn(axis, -rate * t) @ R @ R_c).ravel()
+        start = place - velocity * t
+        array[9:12] = start
+        array[12:15] = axis
+        array[15] = rate
+        array[16:19] = start
+        terms[0] = 0.0
+        terms[0, 0] = STEADY
+        terms[0, 1:4] = velocity
+
+    def place(self, model, state, t):
+        """Put every rider where MuJoCo's last kinematics have its body (at ``t``)."""
+        for body, index, name, placement in self.bodies:
+            self.body_pose(name, placement, state.bodies[index].pose)
+        for surface, slot, name, (R_c, p_c) in self.surfaces:
+            self.surface_motion(name, R_c, p_c, t, surface.motion.array, surface.motion.path.terms)
+        if self.surfaces:
+            model.surfaces.mechanism_moved(t)
+
+    def push(self, model, state):
+        """The contact wrenches of the step just taken, on the MuJoCo bodies:
+        each worn body's, and the reaction of each counter-surface on a
+        mechanism body (at the same contact points, so the pair's torques
+        cancel), applied at the bodies' centres of mass."""
+        d = self.data
+        d.xfrc_applied[:] = 0.0
+        com = d.xipos
+        for body, index, name, placement in self.bodies:
+            s = state.bodies[index]
+            i = self.ids[name]
+            force = s.wrench[0:3]
+            d.xfrc_applied[i, 0:3] += force
+            d.xfrc_applied[i, 3:6] += s.wrench[3:6] + _cross(s.pose[0:3] - com[i], force)
+        wrench = self._wrench
+        for surface, slot, name, _ in self.surfaces:
+            i = self.ids[name]
+            force, moment = np.zeros(3), np.zeros(3)
+            for s in state.bodies:
+                slot_wrench(model, s, slot, wrench)
+                force += wrench[0:3]
+                moment += wrench[3:6]
+            # the reaction: minus the bodies' force, about the world origin
+            d.xfrc_applied[i, 0:3] -= force
+            d.xfrc_applied[i, 3:6] -= moment - _cross(com[i], force)
+
+    def step(self, model, state, k, contact):
+        """Step ``k`` of the mechanism and its riders: ``contact(k)`` takes
+        the contact step of every body (the riders placed at ``k dt``)."""
+        mujoco, m, d = self.mujoco, self.model, self.data
+        mujoco.mj_step1(m, d)
+        contact(k)
+        self.push(model, state)
+        mujoco.mj_step2(m, d)
+        # the kinematics at t + dt place the riders for the next step and the outputs
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        mujoco.mj_comVel(m, d)
+        self.place(model, state, (k + 1) * model.dt)
+
+    # ------------------------------------------------------------ state
+    def _start(self):
+        mujoco, m, d = self.mujoco, self.model, self.data
+        if self.keyframe is None:
+            mujoco.mj_resetData(m, d)
+        else:
+            mujoco.mj_resetDataKeyframe(m, d, self.keyframe)
+        for a, value in self.controls:
+            d.ctrl[a] = value
+        mujoco.mj_forward(m, d)
+
+    def reset(self, model, state):
+        """MuJoCo back at its initial state (the keyframe, or the model's
+        reference pose at rest), the controls set, the riders there."""
+        self._start()
+        self.place(model, state, 0.0)
+
+    def get_state(self):
+        """MuJoCo's whole integration state (time, qpos, qvel, act, ...)."""
+        mujoco = self.mujoco
+        kind = mujoco.mjtState.mjSTATE_INTEGRATION
+        out = np.zeros(mujoco.mj_stateSize(self.model, kind))
+        mujoco.mj_getState(self.model, self.data, out, kind)
+        return out
+
+    def set_state(self, values, model, state):
+        mujoco, m, d = self.mujoco, self.model, self.data
+        mujoco.mj_setState(m, d, np.asarray(values, float), mujoco.mjtState.mjSTATE_INTEGRATION)
+        mujoco.mj_forward(m, d)
+        self.place(model, state, state.time)
+
+    def joints(self):
+        """History columns of the mechanism (docs/outputs.md): each hinge and
+        slide joint's position and velocity (``<joint>.q``, ``<joint>.v``)
+        and each actuator's force (``<actuator>.force``); ball and free
+        joints are in the rows of the parts they carry."""
+        m, d = self.model, self.data
+        out = {}
+        kinds = (int(self.mujoco.mjtJoint.mjJNT_HINGE), int(self.mujoco.mjtJoint.mjJNT_SLIDE))
+        for j in range(m.njnt):
+            if int(m.jnt_type[j]) not in kinds:
+                continue
+            name = m.joint(j).name or f"joint{j}"
+            out[f"{name}.q"] = float(d.qpos[m.jnt_qposadr[j]])
+            out[f"{name}.v"] = float(d.qvel[m.jnt_dofadr[j]])
+        for a in range(m.nu):
+            name = m.actuator(a).name or f"actuator{a}"
+            out[f"{name}.force"] = float(d.actuator_force[a])
+        return out
+
+
+def slot_wrench(model, s, slot, out=None):
+    """(6,) force (N) of counter-surface ``slot`` on a body and its moment
+    about the world origin (N·m), from the body state ``s`` of the step just
+    taken (:func:`meshwear.kernels.mechanism.slot_wrench`)."""
+    out = np.zeros(6) if out is None else out
+    _slot_wrench(s.pose, s.vertices, s.active, s.normal_force, s.tangential, model.planes,
+                 s.vertex_planes, slot, out)
+    return out
