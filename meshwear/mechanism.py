@@ -24,6 +24,7 @@ there, so the loop never moves it between two placings.
 """
 
 import itertools
+import logging
 
 import numpy as np
 
@@ -142,6 +143,11 @@ class Mechanism:
                                  f"{', '.join(map(repr, actuators)) or 'none'})")
             self.controls.append((actuators.index(name), float(value)))
         self.data = mujoco.MjData(m)
+        self._bad_acceleration = int(mujoco.mjtWarning.mjWARN_BADQACC)
+        if mujoco.get_mju_user_warning() is None:
+            # MuJoCo's warnings to meshwear's log, not to stdout and MUJOCO_LOG.TXT
+            log = logging.getLogger("meshwear")
+            mujoco.set_mju_user_warning(lambda text: log.warning("MuJoCo: %s", text))
         self._start()
         self.ids = {name: m.body(name).id for name in handled}
         self.path = path
@@ -319,17 +325,28 @@ class Mechanism:
 
     def step(self, model, state, k, contact):
         """Step ``k`` of the mechanism and its riders: ``contact(k)`` takes
-        the contact step of every body (the riders placed at ``k dt``)."""
+        the contact step of every body (the riders placed at ``k dt``).
+        Returns False if MuJoCo found its accelerations non-finite in the
+        step (it then resets itself: the run cannot go on)."""
         mujoco, m, d = self.mujoco, self.model, self.data
         mujoco.mj_step1(m, d)
         contact(k)
         self.push(model, state)
         mujoco.mj_step2(m, d)
+        if d.warning[self._bad_acceleration].number:
+            return False
         # the kinematics at t + dt place the riders for the next step and the outputs
         mujoco.mj_kinematics(m, d)
         mujoco.mj_comPos(m, d)
         mujoco.mj_comVel(m, d)
         self.place(model, state, (k + 1) * model.dt)
+        return True
+
+    def instability(self, model, t):
+        """The message of a step MuJoCo found unstable at ``t``."""
+        return (f"mechanism {self.path.name}: MuJoCo's accelerations became non-finite in the "
+                f"step from t = {t:.6g} s (unstable coupled step): shorten run.dt, soften the "
+                "contact, or integrate stiff actuators implicitly (integrator=\"implicitfast\")")
 
     # ------------------------------------------------------------ state
     def _start(self):

@@ -35,7 +35,9 @@ def step(model, state):
     """Advance ``state`` by one time step of ``model``, in place: the Python
     reference of the compiled loop (:func:`advance` uses that)."""
     if model.mechanism is not None:
-        model.mechanism.step(model, state, state.step, partial(_step_bodies, model, state))
+        if not model.mechanism.step(model, state, state.step,
+                                    partial(_step_bodies, model, state)):
+            raise NumericalError(model.mechanism.instability(model, state.time))
     else:
         _step_bodies(model, state, state.step)
     state.step += 1

@@ -39,8 +39,11 @@ def advance(model, state, until):
     mechanism, a step at a time, MuJoCo's step around the bodies')."""
     if model.mechanism is not None:
         for k in range(state.step, until):
-            model.mechanism.step(model, state, k,
-                                 lambda k: _advance_bodies(model, state, k, k + 1))
+            if not model.mechanism.step(model, state, k,
+                                        lambda k: _advance_bodies(model, state, k, k + 1)):
+                from .simulate import NumericalError
+
+                raise NumericalError(model.mechanism.instability(model, k * model.dt))
     elif model.worn_counters and len(model.bodies) > 1:
         for k in range(state.step, until):
             _advance_bodies(model, state, k, k + 1)

@@ -196,3 +196,56 @@ def test_history_carries_the_joints_and_actuators(tmp_path):
         assert column in header
     assert math.isfinite(float((out / "history.csv").read_text().splitlines()[-1].split(",")[
         header.index("spin.v")]))
+
+
+def test_an_unstable_coupled_step_stops_the_run_with_exit_3(tmp_path, capsys):
+    """An explicit Euler step of a stiff velocity servo on a light disc blows
+    up in MuJoCo, which would reset itself and go on: meshwear stops there."""
+    xml = (PIN_ON_DISC.parent / "pin_on_disc.xml").read_text()
+    (tmp_path / "pin_on_disc.xml").write_text(xml.replace('integrator="implicitfast"',
+                                                          'integrator="Euler"'))
+    (tmp_path / "scene.toml").write_text(PIN_ON_DISC.read_text())
+    code = main(["run", str(tmp_path / "scene.toml"), "-o", str(tmp_path / "out"), "-q",
+                 "--set", "run.duration=0.05", "--set", "body[0].resolution=2e-3"])
+    err = capsys.readouterr().err
+    assert code == 3 and "non-finite" in err and "implicitfast" in err
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
+def _toss_scenes(tmp_path, height=0.011):
+    """The cube of examples/cube_toss.toml thrown flat from 1 mm above the
+    plate, sliding and spinning (0.3, 0.1) m/s and 3 rad/s: as meshwear's own
+    free body, and as a MuJoCo free joint carrying the same mesh."""
+    source = (cases.EXAMPLES / "cube_toss.toml").read_text()
+    source = source.replace('"../meshes/', f'"{cases.EXAMPLES.parent / "meshes"}/')
+    own = (source.replace("position = [-0.04, 0.0, 0.03]", f"position = [-0.04, 0.0, {height}]")
+           .replace("orientation = [0.9238795, 0.3826834, 0.0, 0.0]", "orientation = [1, 0, 0, 0]")
+           .replace("angular_velocity = [2.0, -3.0, 1.0]", "angular_velocity = [0, 0, 3.0]"))
+    (tmp_path / "own.toml").write_text(own)
+    (tmp_path / "cube.xml").write_text(f"""<mujoco><worldbody>
+      <body name="cube" pos="-0.04 0 {height}"><freejoint name="free"/>
+        <geom type="box" size="0.01 0.01 0.01" density="7850"/></body></worldbody>
+      <keyframe><key name="toss" qpos="-0.04 0 {height} 1 0 0 0" qvel="0.3 0.1 0 0 0 3"/></keyframe>
+    </mujoco>""")
+    rider = [line for line in own.splitlines() if not line.startswith(
+        ("density", "position", "orientation", "velocity", "angular_velocity"))]
+    rider = "\n".join(rider).replace('name = "cube"', 'name = "cube"\nmechanism_body = "cube"')
+    rider = rider.replace("[run]", '[mechanism]\nmodel = "cube.xml"\nkeyframe = "toss"\n\n[run]')
+    (tmp_path / "rider.toml").write_text(rider)
+    return tmp_path / "own.toml", tmp_path / "rider.toml"
+
+
+def test_a_tossed_cube_integrated_by_mujoco_comes_to_rest_as_meshwears_own(tmp_path):
+    results = []
+    for path in _toss_scenes(tmp_path):
+        model, state, rows = _run(load_scene(path, [("run.duration", 0.6), ("run.frames", 0)]))
+        results.append((state.bodies[0].pose.copy(), rows["cube"]))
+    (own, own_rows), (mj, mj_rows) = results
+    start = own_rows["pose"][0]
+    assert np.linalg.norm(own[7:13]) < 1e-6 and np.linalg.norm(mj[7:13]) < 1e-6    # at rest
+    travel = np.linalg.norm(own[0:3] - start[0:3])
+    assert np.linalg.norm(mj[0:3] - own[0:3]) <= 0.02 * travel
+    assert mj[2] == pytest.approx(own[2], abs=1e-7)                    # on a face, same sink
+    turned = 2.0 * np.arccos(min(1.0, abs(float(own[3:7] @ mj[3:7]))))
+    assert turned <= 0.02                                              # rad
+    assert mj_rows["friction_work"][-1] == pytest.approx(own_rows["friction_work"][-1], rel=0.02)
