@@ -28,8 +28,8 @@ import logging
 
 import numpy as np
 
-from .kernels.mechanism import slot_wrench as _slot_wrench
-from .kernels.rigid import STEADY
+from .kernels.mechanism import (place_body, place_surface, push_body, push_reaction,
+                                slot_wrench as _slot_wrench)
 from .scene import SceneError
 from .stability import STABILITY_MARGIN, _contact_matrix, _stable_step, vertex_stiffness
 from .surfaces.base import quaternion_matrix
@@ -47,28 +47,6 @@ def _mujoco(source):
 def _first_line(err):
     text = str(err).strip().splitlines()
     return " ".join(line.strip() for line in text[:2]) if text else type(err).__name__
-
-
-def _quaternion_product(a, b):
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-                     w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
-
-
-def _cross(a, b):
-    """a x b of two 3-vectors (np.cross costs 20 µs a call)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
-                     a[0] * b[1] - a[1] * b[0]])
-
-
-def _turn(axis, angle):
-    x, y, z = axis
-    c, s = np.cos(angle), np.sin(angle)
-    K = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
 
 
 class Mechanism:
@@ -153,7 +131,7 @@ class Mechanism:
         self.path = path
         #: (part, state index, MuJoCo body id, placement) of the riders, set by the model
         self.bodies, self.surfaces = [], []
-        self._velocity, self._wrench = np.zeros(6), np.zeros(6)
+        self._wrench = np.zeros(6)
 
     # ------------------------------------------------------------ set-up
     def set_timestep(self, dt):
@@ -162,16 +140,6 @@ class Mechanism:
     def mass(self, name):
         """Mass (kg) of MuJoCo body ``name``."""
         return float(self.model.body_mass[self.ids[name]])
-
-    def frame(self, name):
-        """World rotation (3, 3), origin, velocity of the origin and angular
-        velocity of the frame of MuJoCo body ``name``, as MuJoCo's last
-        kinematics left them."""
-        mujoco, m, d = self.mujoco, self.model, self.data
-        i = self.ids[name]
-        mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_XBODY, i, self._velocity, 0)
-        return (d.xmat[i].reshape(3, 3).copy(), d.xpos[i].copy(), self._velocity[3:6].copy(),
-                self._velocity[0:3].copy())
 
     def jacobian(self, name, point):
         """(6, nv) velocity of ``point`` (world) moving with body ``name``,
@@ -253,75 +221,55 @@ class Mechanism:
         return lines
 
     # ------------------------------------------------------------ coupling
+    def _arrays(self):
+        d = self.data
+        return d.xpos, d.xquat, d.xmat, d.cvel, d.subtree_com, self.model.body_rootid
+
     def body_pose(self, name, placement, out=None):
         """The (13,) pose of a part placed at ``placement`` (its pose in the
-        frame of body ``name``: centre of mass and orientation) in the world."""
-        R, origin, v, w = self.frame(name)
-        q = self.data.xquat[self.ids[name]]
+        frame of body ``name``: centre of mass and orientation) in the world,
+        where MuJoCo's last kinematics have that body."""
         out = np.zeros(13) if out is None else out
-        arm = R @ placement[0:3]
-        out[0:3] = origin + arm
-        out[3:7] = _quaternion_product(q, placement[3:7])
-        out[3:7] /= np.linalg.norm(out[3:7])
-        out[7:10] = v + _cross(w, arm)
-        out[10:13] = w
+        place_body(*self._arrays(), self.ids[name], placement, out)
         return out
 
-    def surface_motion(self, name, R_c, p_c, t, array, terms):
+    def surface_motion(self, name, rest, t, array, terms):
         """Write a surface's motion (``array`` (19,), ``terms`` (1, 9)) so
         its frame at ``t``, and its velocity field about it, are those of
-        body ``name`` with the surface placed in it at ``R_c``, ``p_c``: a
-        steady turn at the body's angular velocity and a steady velocity
-        (:mod:`meshwear.kernels.frames`)."""
-        R, origin, v, w = self.frame(name)
-        arm = R @ p_c
-        place, velocity = origin + arm, v + _cross(w, arm)
-        rate = float(np.linalg.norm(w))
-        axis = w / rate if rate > 0.0 else np.array([0.0, 0.0, 1.0])
-        array[0:9] = (_turn(axis, -rate * t) @ R @ R_c).ravel()
-        start = place - velocity * t
-        array[9:12] = start
-        array[12:15] = axis
-        array[15] = rate
-        array[16:19] = start
-        terms[0] = 0.0
-        terms[0, 0] = STEADY
-        terms[0, 1:4] = velocity
+        body ``name`` with the surface at ``rest`` in it (12,: rotation row
+        by row, then position): a steady turn at the body's angular velocity
+        and a steady velocity (:func:`meshwear.kernels.mechanism.place_surface`)."""
+        xpos, _, xmat, cvel, com, root = self._arrays()
+        place_surface(xpos, xmat, cvel, com, root, self.ids[name], rest, float(t), array, terms)
 
     def place(self, model, state, t):
         """Put every rider where MuJoCo's last kinematics have its body (at ``t``)."""
+        xpos, xquat, xmat, cvel, com, root = self._arrays()
         for body, index, name, placement in self.bodies:
-            self.body_pose(name, placement, state.bodies[index].pose)
-        for surface, slot, name, (R_c, p_c) in self.surfaces:
-            self.surface_motion(name, R_c, p_c, t, surface.motion.array, surface.motion.path.terms)
+            place_body(xpos, xquat, xmat, cvel, com, root, self.ids[name], placement,
+                       state.bodies[index].pose)
+        for surface, slot, name, rest in self.surfaces:
+            place_surface(xpos, xmat, cvel, com, root, self.ids[name], rest, float(t),
+                          surface.motion.array, surface.motion.path.terms)
         if self.surfaces:
             model.surfaces.mechanism_moved(t)
 
     def push(self, model, state):
         """The contact wrenches of the step just taken, on the MuJoCo bodies:
         each worn body's, and the reaction of each counter-surface on a
-        mechanism body (at the same contact points, so the pair's torques
+        mechanism body (at the same contact points, so the pair's moments
         cancel), applied at the bodies' centres of mass."""
         d = self.data
-        d.xfrc_applied[:] = 0.0
-        com = d.xipos
+        xfrc, xipos = d.xfrc_applied, d.xipos
+        xfrc[:] = 0.0
         for body, index, name, placement in self.bodies:
             s = state.bodies[index]
-            i = self.ids[name]
-            force = s.wrench[0:3]
-            d.xfrc_applied[i, 0:3] += force
-            d.xfrc_applied[i, 3:6] += s.wrench[3:6] + _cross(s.pose[0:3] - com[i], force)
+            push_body(xipos, xfrc, self.ids[name], s.pose, s.wrench)
         wrench = self._wrench
         for surface, slot, name, _ in self.surfaces:
-            i = self.ids[name]
-            force, moment = np.zeros(3), np.zeros(3)
             for s in state.bodies:
                 slot_wrench(model, s, slot, wrench)
-                force += wrench[0:3]
-                moment += wrench[3:6]
-            # the reaction: minus the bodies' force, about the world origin
-            d.xfrc_applied[i, 0:3] -= force
-            d.xfrc_applied[i, 3:6] -= moment - _cross(com[i], force)
+                push_reaction(xipos, xfrc, self.ids[name], wrench)
 
     def step(self, model, state, k, contact):
         """Step ``k`` of the mechanism and its riders: ``contact(k)`` takes

@@ -374,13 +374,14 @@ def _ride(mechanism, surface, index, name, t):
 
     m = surface.motion
     if not getattr(surface, "rider", False):
-        surface.placement = (m.R0.copy(), m.position.copy())
+        # its rest frame in the mechanism body's: rotation row by row, position
+        surface.placement = np.concatenate([m.R0.ravel(), m.position])
         m.path.terms = np.zeros((1, 9))
         m.path.terms[0, 0] = STEADY
         surface.rider = True
         surface.invariant = False
         surface._compiled = None
-    mechanism.surface_motion(name, *surface.placement, t, m.array, m.path.terms)
+    mechanism.surface_motion(name, surface.placement, t, m.array, m.path.terms)
     mechanism.surfaces.append((surface, index, name, surface.placement))
 
 

@@ -249,3 +249,39 @@ def test_a_tossed_cube_integrated_by_mujoco_comes_to_rest_as_meshwears_own(tmp_p
     turned = 2.0 * np.arccos(min(1.0, abs(float(own[3:7] @ mj[3:7]))))
     assert turned <= 0.02                                              # rad
     assert mj_rows["friction_work"][-1] == pytest.approx(own_rows["friction_work"][-1], rel=0.02)
+
+
+PENDULUM = cases.EXAMPLES / "mechanisms" / "pendulum_in_bushing.toml"
+
+
+def test_a_pendulum_hung_by_a_worn_pin_loads_its_bushing_as_an_ideal_hinge():
+    """The bob m at L on a light rod, the pin m_p at the pivot, released from
+    θ0: the hinge reaction is m a_bob + (m + m_p) g (the pin does not move),
+    with θ'' = -m g L sin θ / I_p; at the bottom m L θ'^2 + (m + m_p) g,
+    θ'^2 = 2 m g L (1 - cos θ0) / I_p. The bushing wears k N ds, ds the
+    sliding at the contact: the contact stays on the rod's line, so it
+    sweeps the bore (radius r_pin + c) as the pendulum turns."""
+    model, state, rows = _run(load_scene(PENDULUM))
+    pin = rows["pin"]
+    m, m_pin, L, g, r_bob, theta0 = 0.1, 0.02, 0.2, 9.81, 0.005, math.radians(30.0)
+    r_bore, mu, k = 0.00505, 0.1, 1e-13
+    I_p = m * L * L + 0.4 * m * r_bob * r_bob
+    theta, rate = pin["swing.q"], pin["swing.v"]
+    assert theta[0] == pytest.approx(theta0) and theta[-1] < 0.0          # past the bottom
+    acc = -m * g * L * np.sin(theta) / I_p
+    ideal = np.stack([m * L * (acc * np.cos(theta) - rate ** 2 * np.sin(theta)),
+                      m * L * (acc * np.sin(theta) + rate ** 2 * np.cos(theta))
+                      + (m + m_pin) * g], axis=1)
+    measured = pin["wrench"][:, 0:2]
+    settled = pin["time"] >= 0.004          # the pin seats in the bore in its first steps
+    ratio = np.linalg.norm(measured, axis=1)[settled] / np.linalg.norm(ideal, axis=1)[settled]
+    assert np.all(np.abs(ratio - 1.0) <= 0.02)
+    bottom = np.argmin(np.abs(theta))
+    closed = m * g * (1.0 + 2.0 * m * L * L * (1.0 - math.cos(theta0)) / I_p) + m_pin * g
+    assert np.linalg.norm(measured[bottom]) == pytest.approx(closed, rel=0.02)
+    # all points slip while it swings: N = |F| / sqrt(1 + mu^2)
+    normal = np.linalg.norm(measured, axis=1) / math.hypot(1.0, mu)
+    sliding = r_bore * np.abs(np.diff(theta))
+    work = np.sum(0.5 * (normal[1:] + normal[:-1]) * sliding)
+    bushing = state.parts[0].volume.sum()
+    assert bushing == pytest.approx(k * work, rel=0.01)

@@ -1,11 +1,16 @@
-"""The reaction of a counter-surface on the MuJoCo body it rides on
-(:mod:`meshwear.mechanism`): the force of one contact slot on a worn body,
-summed over its active vertices, and its moment about the world origin."""
+"""The coupling of worn parts with a MuJoCo mechanism (:mod:`meshwear.mechanism`),
+on MuJoCo's own arrays (``xpos``, ``xquat``, ``xmat``, ``cvel``,
+``subtree_com``, ``xipos``, ``xfrc_applied``, ``body_rootid``): the parts
+placed where their bodies are, the contact wrenches applied to the bodies,
+and the reaction of a counter-surface (the force of one contact slot on a
+worn body, summed over its active vertices, and its moment about the world
+origin). Twins in tests/test_mechanism.py."""
 
 import numpy as np
 from numba import njit
 
 from .contact import FORCE, rotation_entries
+from .rigid import STEADY
 
 
 @njit(cache=True)
@@ -46,3 +51,127 @@ def slot_wrench(pose, vertices, active, normal_force, tangential, planes, vertex
         out[3] += y * fz - z * fy
         out[4] += z * fx - x * fz
         out[5] += x * fy - y * fx
+
+
+@njit(cache=True, inline="always")
+def _body_velocity(xpos, cvel, subtree_com, rootid, body):
+    """Velocity of the origin of MuJoCo body ``body``'s frame and its angular
+    velocity (world), from MuJoCo's com-based velocities ``cvel`` (rotation,
+    translation at the centre of mass of the body's kinematic tree)."""
+    root = rootid[body]
+    wx, wy, wz = cvel[body, 0], cvel[body, 1], cvel[body, 2]
+    dx = xpos[body, 0] - subtree_com[root, 0]
+    dy = xpos[body, 1] - subtree_com[root, 1]
+    dz = xpos[body, 2] - subtree_com[root, 2]
+    return (cvel[body, 3] + wy * dz - wz * dy, cvel[body, 4] + wz * dx - wx * dz,
+            cvel[body, 5] + wx * dy - wy * dx, wx, wy, wz)
+
+
+@njit(cache=True)
+def place_body(xpos, xquat, xmat, cvel, subtree_com, rootid, body, placement, pose):
+    """``pose`` (13,) of a part placed at ``placement`` (13,: its centre of
+    mass and orientation in the frame of MuJoCo body ``body``) where MuJoCo's
+    last kinematics have that body: centre of mass, quaternion, velocity and
+    angular velocity, world frame."""
+    vx, vy, vz, wx, wy, wz = _body_velocity(xpos, cvel, subtree_com, rootid, body)
+    px, py, pz = placement[0], placement[1], placement[2]
+    ax = xmat[body, 0] * px + xmat[body, 1] * py + xmat[body, 2] * pz
+    ay = xmat[body, 3] * px + xmat[body, 4] * py + xmat[body, 5] * pz
+    az = xmat[body, 6] * px + xmat[body, 7] * py + xmat[body, 8] * pz
+    pose[0] = xpos[body, 0] + ax
+    pose[1] = xpos[body, 1] + ay
+    pose[2] = xpos[body, 2] + az
+    w1, x1, y1, z1 = xquat[body, 0], xquat[body, 1], xquat[body, 2], xquat[body, 3]
+    w2, x2, y2, z2 = placement[3], placement[4], placement[5], placement[6]
+    qw = w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2
+    qx = w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2
+    qy = w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2
+    qz = w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2
+    norm = np.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+    pose[3], pose[4], pose[5], pose[6] = qw / norm, qx / norm, qy / norm, qz / norm
+    pose[7] = vx + wy * az - wz * ay
+    pose[8] = vy + wz * ax - wx * az
+    pose[9] = vz + wx * ay - wy * ax
+    pose[10], pose[11], pose[12] = wx, wy, wz
+
+
+@njit(cache=True)
+def place_surface(xpos, xmat, cvel, subtree_com, rootid, body, rest, t, motion, terms):
+    """Write a counter-surface's ``motion`` (19,) and path ``terms`` (1, 9)
+    (:mod:`meshwear.kernels.frames`) so its frame at ``t``, and the velocity
+    field about it, are those of MuJoCo body ``body`` with the surface at
+    ``rest`` (12,: rotation row by row, then position, in the body's frame):
+    a steady turn at the body's angular velocity and a steady velocity."""
+    vx, vy, vz, wx, wy, wz = _body_velocity(xpos, cvel, subtree_com, rootid, body)
+    R = xmat[body]
+    # the surface's frame in the world: Rw = R Rc, origin p + R pc
+    px, py, pz = rest[9], rest[10], rest[11]
+    ax = R[0] * px + R[1] * py + R[2] * pz
+    ay = R[3] * px + R[4] * py + R[5] * pz
+    az = R[6] * px + R[7] * py + R[8] * pz
+    ux = vx + wy * az - wz * ay
+    uy = vy + wz * ax - wx * az
+    uz = vz + wx * ay - wy * ax
+    rate = np.sqrt(wx * wx + wy * wy + wz * wz)
+    if rate > 0.0:
+        ex, ey, ez = wx / rate, wy / rate, wz / rate
+    else:
+        ex, ey, ez = 0.0, 0.0, 1.0
+    # R0 = Rot(e, -rate t) Rw, so that Rot(e, rate t) R0 = Rw at t
+    c, s = np.cos(-rate * t), np.sin(-rate * t)
+    k = 1.0 - c
+    turn = (c + k * ex * ex, k * ex * ey - s * ez, k * ex * ez + s * ey,
+            k * ex * ey + s * ez, c + k * ey * ey, k * ey * ez - s * ex,
+            k * ex * ez - s * ey, k * ey * ez + s * ex, c + k * ez * ez)
+    for r in range(3):
+        for col in range(3):
+            world = (R[3 * r] * rest[col] + R[3 * r + 1] * rest[3 + col]
+                     + R[3 * r + 2] * rest[6 + col])
+            motion[3 * r + col] = world
+    for col in range(3):
+        a0, a1, a2 = motion[col], motion[3 + col], motion[6 + col]
+        for r in range(3):
+            motion[3 * r + col] = turn[3 * r] * a0 + turn[3 * r + 1] * a1 + turn[3 * r + 2] * a2
+    sx = xpos[body, 0] + ax - ux * t
+    sy = xpos[body, 1] + ay - uy * t
+    sz = xpos[body, 2] + az - uz * t
+    motion[9], motion[10], motion[11] = sx, sy, sz
+    motion[12], motion[13], motion[14] = ex, ey, ez
+    motion[15] = rate
+    motion[16], motion[17], motion[18] = sx, sy, sz
+    for j in range(9):
+        terms[0, j] = 0.0
+    terms[0, 0] = STEADY
+    terms[0, 1], terms[0, 2], terms[0, 3] = ux, uy, uz
+
+
+@njit(cache=True)
+def push_body(xipos, xfrc, body, pose, wrench):
+    """Add a worn body's contact ``wrench`` (force and torque about its centre
+    of mass ``pose[0:3]``) to MuJoCo body ``body``'s applied force and torque
+    at that body's centre of mass ``xipos``."""
+    fx, fy, fz = wrench[0], wrench[1], wrench[2]
+    dx = pose[0] - xipos[body, 0]
+    dy = pose[1] - xipos[body, 1]
+    dz = pose[2] - xipos[body, 2]
+    xfrc[body, 0] += fx
+    xfrc[body, 1] += fy
+    xfrc[body, 2] += fz
+    xfrc[body, 3] += wrench[3] + dy * fz - dz * fy
+    xfrc[body, 4] += wrench[4] + dz * fx - dx * fz
+    xfrc[body, 5] += wrench[5] + dx * fy - dy * fx
+
+
+@njit(cache=True)
+def push_reaction(xipos, xfrc, body, wrench):
+    """Subtract a slot's ``wrench`` on the bodies (force, moment about the
+    world origin: :func:`slot_wrench`) from MuJoCo body ``body``'s applied
+    force and torque at its centre of mass: the counter-surface's reaction."""
+    fx, fy, fz = wrench[0], wrench[1], wrench[2]
+    cx, cy, cz = xipos[body, 0], xipos[body, 1], xipos[body, 2]
+    xfrc[body, 0] -= fx
+    xfrc[body, 1] -= fy
+    xfrc[body, 2] -= fz
+    xfrc[body, 3] -= wrench[3] - (cy * fz - cz * fy)
+    xfrc[body, 4] -= wrench[4] - (cz * fx - cx * fz)
+    xfrc[body, 5] -= wrench[5] - (cx * fy - cy * fx)
