@@ -43,7 +43,7 @@ import numpy as np
 
 from .kernels.balance import solve
 from .kernels.contact import FACING
-from .motion import BalancedMotion, GuidedMotion
+from .motion import BalancedMotion, GuidedMotion, MechanismMotion
 from .surfaces import quaternion_matrix, vertex_feet
 
 
@@ -191,16 +191,28 @@ def measure(model, body, s, rate, start=None, window=1):
         now[known] += 0.5 * change[known]
     motion = body.motion
     guided = isinstance(motion, (BalancedMotion, GuidedMotion)) and model.slots > 0
+    rider = isinstance(motion, MechanismMotion) and model.slots > 0
     beta, carried = np.zeros(len(rate)), 0.0
-    if guided:
+    if guided or rider:
         # a vertex that faces no surface at the end of the cycle was pressed,
         # while in contact, against its own outward normal
         facing = np.where(np.any(normal != 0.0, axis=1)[:, None], normal,
                           -(body.area_vectors[index, 0:3] @ quaternion_matrix(s.pose[3:7]).T)
                           / np.maximum(body.area_vectors[index, 3:4], 1e-300))
+    if guided:
         beta = facing @ motion.axis
         carried = (motion.carried if isinstance(motion, BalancedMotion)
                 else -float(motion.params[19:22] @ motion.axis) / motion.params[0])
+    elif rider:
+        # a part on a mechanism body: the mechanism holds its contact force
+        # at the end of the cycle (a press, a joint's reaction) while it
+        # wears, as a guided body's load along the direction of that force
+        pressed = (depth > 0.0) & np.isfinite(depth) & (stiffness > 0.0)
+        total = (stiffness[pressed] * depth[pressed]) @ facing[pressed]
+        carried = float(np.linalg.norm(total))
+        if carried > 0.0:
+            guided = True
+            beta = facing @ (total / carried)
     m = BodyJump(index, alpha, np.where(np.isfinite(depth), depth, 0.0), mean, now, normal,
                  stiffness, member, touched, beta, carried, guided)
     m.rest = _step(m, 0.0, m.depth, m.now)[1]

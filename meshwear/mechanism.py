@@ -296,6 +296,13 @@ class Mechanism:
                 f"step from t = {t:.6g} s (unstable coupled step): shorten run.dt, soften the "
                 "contact, or integrate stiff actuators implicitly (integrator=\"implicitfast\")")
 
+    def jumped(self, model, state, duration):
+        """A cycle jump moved meshwear's clock by ``duration`` (whole cycles):
+        MuJoCo's with it, its state otherwise that of the end of the resolved
+        cycle, the riders placed at the new time."""
+        self.data.time += duration
+        self.place(model, state, state.time)
+
     # ------------------------------------------------------------ state
     def _start(self):
         mujoco, m, d = self.mujoco, self.model, self.data

@@ -661,9 +661,9 @@ class Scene:
             if self.run.mode == "quasi-static":
                 fail("run.mode", "'quasi-static' does not apply to a scene with a "
                      "[mechanism]: MuJoCo integrates it in time; use 'dynamic'")
-            if self.wear.acceleration == "cycle_jump":
-                fail("wear.acceleration", "'cycle_jump' does not apply to a scene with a "
-                     "[mechanism] yet; use 'none'")
+            if self.wear.acceleration == "cycle_jump" and self.wear.period is None:
+                fail("wear.period", "missing; 'cycle_jump' with a [mechanism] needs its "
+                     "cycle length (a driven crank's turn: 2 pi / speed)")
         if self.wear.acceleration == "cycle_jump" and self.wear.period is None and not any(
                 (x.path is not None and x.path.periodic)
                 or (getattr(x, "rotation", None) is not None and x.rotation.rate != 0.0)
