@@ -134,6 +134,31 @@ class Mechanism:
         self._wrench = np.zeros(6)
 
     # ------------------------------------------------------------ set-up
+    def finish(self):
+        """After the model is built: the riders' motions become rows of one
+        array the compiled loop writes (each surface's arrays views of it),
+        and MuJoCo's C functions are looked up for that loop."""
+        S = len(self.surfaces)
+        self.rows, self.row_terms = np.zeros((S, 19)), np.zeros((S, 1, 9))
+        for r, (surface, slot, name, rest) in enumerate(self.surfaces):
+            m = surface.motion
+            self.rows[r], self.row_terms[r] = m.array, m.path.terms
+            m.array, m.path.terms = self.rows[r], self.row_terms[r]
+            surface._compiled = None        # its tuple takes the views
+        self.surface_riders = np.array([[slot, self.ids[name]] for _, slot, name, _ in
+                                        self.surfaces], dtype=np.int64).reshape(-1, 2)
+        self.rests = np.array([rest for *_, rest in self.surfaces], float).reshape(-1, 12)
+        self.body_riders = np.array([[index, self.ids[name]] for _, index, name, _ in
+                                     self.bodies], dtype=np.int64).reshape(-1, 2)
+        self.placements = np.array([p for *_, p in self.bodies], float).reshape(-1, 13)
+        self.calls = _c_functions(self.mujoco)
+
+    def compiled_arrays(self):
+        """MuJoCo's arrays the compiled loop reads and writes (views of its data)."""
+        d, m = self.data, self.model
+        return (d.xpos, d.xquat, d.xmat, d.cvel, d.subtree_com, d.xipos, d.xfrc_applied,
+                m.body_rootid)
+
     def set_timestep(self, dt):
         self.model.opt.timestep = float(dt)
 
@@ -281,7 +306,7 @@ class Mechanism:
         contact(k)
         self.push(model, state)
         mujoco.mj_step2(m, d)
-        if d.warning[self._bad_acceleration].number:
+        if not self.stable():
             return False
         # the kinematics at t + dt place the riders for the next step and the outputs
         mujoco.mj_kinematics(m, d)
@@ -290,10 +315,18 @@ class Mechanism:
         self.place(model, state, (k + 1) * model.dt)
         return True
 
-    def instability(self, model, t):
-        """The message of a step MuJoCo found unstable at ``t``."""
+    def stable(self):
+        """MuJoCo found no non-finite acceleration since the start (it then
+        resets its state and goes on: the run cannot)."""
+        return self.data.warning[self._bad_acceleration].number == 0
+
+    def instability(self, model, t, until=None):
+        """The message of a step MuJoCo found unstable at ``t`` (or between
+        ``t`` and ``until``)."""
+        when = f"step from t = {t:.6g} s" if until is None else (
+            f"steps from t = {t:.6g} s to {until:.6g} s")
         return (f"mechanism {self.path.name}: MuJoCo's accelerations became non-finite in the "
-                f"step from t = {t:.6g} s (unstable coupled step): shorten run.dt, soften the "
+                f"{when} (unstable coupled step): shorten run.dt, soften the "
                 "contact, or integrate stiff actuators implicitly (integrator=\"implicitfast\")")
 
     def jumped(self, model, state, duration):
@@ -306,6 +339,7 @@ class Mechanism:
     # ------------------------------------------------------------ state
     def _start(self):
         mujoco, m, d = self.mujoco, self.model, self.data
+        d.warning[self._bad_acceleration].number = 0
         if self.keyframe is None:
             mujoco.mj_resetData(m, d)
         else:
@@ -352,6 +386,31 @@ class Mechanism:
             name = m.actuator(a).name or f"actuator{a}"
             out[f"{name}.force"] = float(d.actuator_force[a])
         return out
+
+
+def _c_functions(mujoco):
+    """MuJoCo's ``mj_step1``, ``mj_step2``, ``mj_kinematics``, ``mj_comPos``
+    and ``mj_comVel`` as C function pointers the compiled loop calls, from
+    the library the ``mujoco`` package ships; None if it cannot be found
+    (the steps then go through Python, a few times slower)."""
+    import ctypes
+    import glob
+    import os
+
+    folder = os.path.dirname(mujoco.__file__)
+    for pattern in ("libmujoco.so*", "libmujoco*.dylib", "mujoco.dll"):
+        for path in sorted(glob.glob(os.path.join(folder, pattern))):
+            try:
+                lib = ctypes.CDLL(path)
+                out = []
+                for name in ("mj_step1", "mj_step2", "mj_kinematics", "mj_comPos", "mj_comVel"):
+                    f = getattr(lib, name)
+                    f.argtypes, f.restype = [ctypes.c_void_p, ctypes.c_void_p], None
+                    out.append(f)
+                return tuple(out)
+            except (OSError, AttributeError):
+                continue
+    return None
 
 
 def slot_wrench(model, s, slot, out=None):

@@ -338,6 +338,7 @@ def build_model(scene):
         slot_of = {id(x): k for k, x in enumerate(surface_set.slots)}
         mechanism.surfaces = [(x, slot_of[id(x)], name, placement)
                               for x, _, name, placement in mechanism.surfaces]
+        mechanism.finish()
     periods = _periods(scene)
     period = scene.wear.period or (max(periods) if periods else None)
     slots = plane_array.shape[0] + len(surface_set.per_vertex)

@@ -38,12 +38,7 @@ def advance(model, state, until):
     (bodies that share a worn counter-surface in turn, a step each; with a
     mechanism, a step at a time, MuJoCo's step around the bodies')."""
     if model.mechanism is not None:
-        for k in range(state.step, until):
-            if not model.mechanism.step(model, state, k,
-                                        lambda k: _advance_bodies(model, state, k, k + 1)):
-                from .simulate import NumericalError
-
-                raise NumericalError(model.mechanism.instability(model, k * model.dt))
+        _advance_mechanism(model, state, until)
     elif model.worn_counters and len(model.bodies) > 1:
         for k in range(state.step, until):
             _advance_bodies(model, state, k, k + 1)
@@ -53,8 +48,52 @@ def advance(model, state, until):
     state.time = until * model.dt
 
 
+def _advance_mechanism(model, state, until):
+    """Steps of a mechanism and every body up to ``until``: in the compiled
+    loop (:func:`meshwear.kernels.mechanism.advance_mechanism`), or a step at
+    a time through Python where MuJoCo's library cannot be called from it."""
+    from .kernels.mechanism import advance_mechanism
+    from .simulate import NumericalError
+
+    mech = model.mechanism
+    if mech.calls is None:
+        for k in range(state.step, until):
+            if not mech.step(model, state, k, lambda k: _advance_bodies(model, state, k, k + 1)):
+                raise NumericalError(mech.instability(model, k * model.dt))
+        return
+    surfaces = model.surfaces
+    report = np.zeros(2, np.int64)
+    bodies = tuple(_body_arrays(model, body, s) for body, s in zip(model.bodies, state.bodies))
+    motions = tuple(_motion_arrays(model, body, s) for body, s in zip(model.bodies,
+                                                                      state.bodies))
+    start = state.step
+    k, what, b = advance_mechanism(
+        start, until, model.dt, mech.calls, mech.model._address, mech.data._address,
+        mech.compiled_arrays(), bodies, motions, mech.body_riders, mech.placements,
+        mech.surface_riders, mech.rests, mech.rows, mech.row_terms, surfaces.compiled_planes(),
+        surfaces.compiled_list(), surfaces.bounds, surfaces.terms, report)
+    if not mech.stable():
+        raise NumericalError(mech.instability(model, start * model.dt, until * model.dt))
+    if what != loop.DONE:
+        _stopped(model, model.bodies[b], state.bodies[b], k, what, report)
+
+
+def _stopped(model, body, s, k, what, report):
+    """The error of a step the compiled loop could not take (see
+    :func:`meshwear.kernels.loop.advance_body`)."""
+    from .simulate import counter_too_deep, impact_too_deep, no_balance
+
+    dt = model.dt
+    if what == loop.TOO_DEEP:
+        t = (k + 1) * dt if model.quasi_static else k * dt
+        raise counter_too_deep(model, model.surfaces.per_vertex[report[0]], report[1], t)
+    if what == loop.IMPACT:
+        raise impact_too_deep(model, body, s, report[0], report[1], k * dt)
+    raise no_balance(body, (k + 1) * dt)
+
+
 def _advance_bodies(model, state, start, until):
-    from .simulate import counter_too_deep, finish_step, impact_too_deep, no_balance, step_body
+    from .simulate import finish_step, step_body
 
     dt = model.dt
     surfaces = model.surfaces
@@ -74,11 +113,6 @@ def _advance_bodies(model, state, start, until):
                 step_body(model, body, s, k)
             elif what == loop.FINISH:
                 finish_step(model, body, s, (k + 1) * dt)
-            elif what == loop.TOO_DEEP:
-                t = (k + 1) * dt if model.quasi_static else k * dt
-                raise counter_too_deep(model, surfaces.per_vertex[report[0]], report[1], t)
-            elif what == loop.IMPACT:
-                raise impact_too_deep(model, body, s, report[0], report[1], k * dt)
             else:
-                raise no_balance(body, (k + 1) * dt)
+                _stopped(model, body, s, k, what, report)
             k += 1

@@ -10,6 +10,7 @@ import numpy as np
 from numba import njit
 
 from .contact import FORCE, rotation_entries
+from .loop import DONE, advance_body
 from .rigid import STEADY
 
 
@@ -175,3 +176,75 @@ def push_reaction(xipos, xfrc, body, wrench):
     xfrc[body, 3] -= wrench[3] - (cy * fz - cz * fy)
     xfrc[body, 4] -= wrench[4] - (cz * fx - cx * fz)
     xfrc[body, 5] -= wrench[5] - (cx * fy - cy * fx)
+
+
+@njit(cache=True)
+def advance_mechanism(k, stop, dt, calls, m, d, mj, bodies, motions, body_riders, placements,
+                      surface_riders, rests, rows, row_terms, planes, surfaces, bounds, terms,
+                      report):
+    """Steps ``k`` up to ``stop`` of a mechanism and every body, without
+    returning to Python (:meth:`meshwear.mechanism.Mechanism.step` is the
+    reference it must match to the last bit). Returns ``(step, what, body)``:
+    :data:`meshwear.kernels.loop.DONE`, or the loop's code for ``body`` at
+    ``step`` (a counter vertex worn too deep, a load nothing carries), MuJoCo
+    having taken that step's ``mj_step1`` only.
+
+    calls
+        MuJoCo's ``mj_step1``, ``mj_step2``, ``mj_kinematics``, ``mj_comPos``,
+        ``mj_comVel`` (C function pointers) and ``m``, ``d`` the addresses
+        of its ``mjModel`` and ``mjData``.
+    mj
+        Its arrays ``xpos``, ``xquat``, ``xmat``, ``cvel``, ``subtree_com``,
+        ``xipos``, ``xfrc_applied``, ``body_rootid``.
+    bodies, motions
+        Every body's ``body`` and ``motion`` tuples (:mod:`meshwear.kernels.loop`).
+    body_riders, placements
+        (R, 2) body index and MuJoCo body of each worn body on the
+        mechanism, and (R, 13) its placement in that body's frame.
+    surface_riders, rests, rows, row_terms
+        (S, 2) contact slot and MuJoCo body of each counter-surface on the
+        mechanism, (S, 12) its rest frame in that body's, and the (S, 19)
+        motions and (S, 1, 9) terms the surfaces' tuples read (a uniform
+        plane's are copied into ``planes``).
+    """
+    xpos, xquat, xmat, cvel, com, xipos, xfrc, rootid = mj
+    mj_step1, mj_step2, kinematics, com_pos, com_vel = calls
+    n_planes = planes[0].shape[0]
+    wrench = np.zeros(6)
+    while k < stop:
+        mj_step1(m, d)
+        for b in range(len(bodies)):
+            reached, what = advance_body(k, k + 1, dt, False, False, bodies[b], motions[b],
+                                         planes, surfaces, bounds, terms, report)
+            if what != DONE:
+                return k, what, b
+        for j in range(6 * xfrc.shape[0]):
+            xfrc.flat[j] = 0.0
+        for r in range(body_riders.shape[0]):
+            body = bodies[body_riders[r, 0]]
+            push_body(xipos, xfrc, body_riders[r, 1], body[1], body[11])
+        for r in range(surface_riders.shape[0]):
+            for b in range(len(bodies)):
+                body = bodies[b]
+                slot_wrench(body[1], body[0], body[14], body[7], body[6], planes[0], body[12],
+                            surface_riders[r, 0], wrench)
+                push_reaction(xipos, xfrc, surface_riders[r, 1], wrench)
+        mj_step2(m, d)
+        kinematics(m, d)
+        com_pos(m, d)
+        com_vel(m, d)
+        k += 1
+        t = k * dt
+        for r in range(body_riders.shape[0]):
+            place_body(xpos, xquat, xmat, cvel, com, rootid, body_riders[r, 1],
+                       placements[r], bodies[body_riders[r, 0]][1])
+        for r in range(surface_riders.shape[0]):
+            place_surface(xpos, xmat, cvel, com, rootid, surface_riders[r, 1], rests[r], t,
+                          rows[r], row_terms[r])
+            slot = surface_riders[r, 0]
+            if slot < n_planes:
+                for j in range(19):
+                    planes[1][slot, j] = rows[r, j]
+                for j in range(9):
+                    planes[2][slot, 0, j] = row_terms[r, 0, j]
+    return k, DONE, -1
