@@ -82,9 +82,10 @@ def save(path, model, state, wall_time):
             arrays[f"body{k}_{name}"] = getattr(s, name)
         arrays[f"body{k}_active"] = s.active
         arrays[f"body{k}_active_wear"] = s.active_wear
-    if model.mechanism is not None:
-        # MuJoCo's whole integration state: a resumed run continues bit for bit
-        arrays["mechanism_state"] = model.mechanism.get_state()
+    own = model.dynamics.get_state()
+    if own is not None:
+        # a mechanism's (MuJoCo's whole integration state): bit for bit on resuming
+        arrays["dynamics_state"] = own
     for m, part in enumerate(state.parts):
         if part is not None:
             for name in _PART_ARRAYS:
@@ -175,8 +176,8 @@ def load(path, model, state):
                 for name in _PART_ARRAYS:
                     getattr(part, name)[...] = data[f"part{m}_{name}"]
                 model.surfaces.per_vertex[m].rebin()
-        if model.mechanism is not None:
-            model.mechanism.set_state(data["mechanism_state"], model, state)
+        if model.dynamics.get_state() is not None:
+            model.dynamics.set_state(data["dynamics_state"], model, state)
     except (KeyError, ValueError) as err:
         raise SceneError(model.scene.source, "", f"{path} was written by another version of "
                          f"meshwear ({err}); run without --resume to start again") from None

@@ -335,9 +335,8 @@ def _check(scene_path, overrides=()):
               else "no stability limit (nothing integrated in time)")
     print(f"  dt {model.dt:.3g} s, {stable}, {model.n_steps} steps, "
           f"{len(model.frame_steps)} frames, {len(model.sample_steps)} history rows")
-    if model.mechanism is not None:
-        for line in model.mechanism.describe(model):
-            print(f"  {line}")
+    for line in model.dynamics.describe(model):
+        print(f"  {line}")
     if model.cycle_steps:
         cycles = model.n_steps / model.cycle_steps
         print(f"  cycle jumping: {model.cycle_steps} steps per cycle, {cycles:.6g} cycles, "

@@ -16,11 +16,11 @@ counter-surfaces, friction, wear and the evolving geometry. A step of
 5. MuJoCo's force stage and its integration to ``t + dt`` (``mj_step2``),
    then its kinematics there, which place the parts for the next step.
 
-This is the dynamics seam for parts moved by a multibody engine: poses and
+:class:`Mechanism` is one implementation of the dynamics seam
+(:mod:`meshwear.dynamics`; meshwear's own motions are the other): poses and
 velocities out (:meth:`Mechanism.place`), wrenches in (:meth:`Mechanism.push`).
-meshwear's own motions (:mod:`meshwear.motion`) move the other parts in the
-compiled loop; a part on a mechanism body has the motion kind ``FIXED``
-there, so the loop never moves it between two placings.
+A part on a mechanism body has the motion kind ``FIXED`` in the compiled
+loop, so the loop never moves it between two placings.
 """
 
 import itertools
@@ -28,10 +28,12 @@ import logging
 
 import numpy as np
 
-from .kernels.mechanism import (place_body, place_surface, push_body, push_reaction,
-                                slot_wrench as _slot_wrench)
+from .kernels.loop import DONE
+from .kernels.mechanism import (advance_mechanism, place_body, place_surface, push_body,
+                                push_reaction, slot_wrench as _slot_wrench)
+from .packing import body_arrays, motion_arrays
 from .scene import SceneError
-from .stability import STABILITY_MARGIN, _contact_matrix, _stable_step, vertex_stiffness
+from .stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_stiffness
 from .surfaces.base import quaternion_matrix
 
 
@@ -194,7 +196,7 @@ class Mechanism:
             pose = b.initial_pose
             r = b.reference_vertices @ quaternion_matrix(pose[3:7]).T
             k, c = vertex_stiffness(b, law)
-            Kb, Cb = _contact_matrix(k, r), _contact_matrix(c, r)
+            Kb, Cb = contact_matrix(k, r), contact_matrix(c, r)
             Jb = self.jacobian(name, pose[0:3])
             for J in [Jb - self.jacobian(s, pose[0:3]) for s in on] + [Jb] * max(fixed, 1 - len(on)):
                 K += J.T @ Kb @ J
@@ -215,7 +217,7 @@ class Mechanism:
             Mab = M[np.ix_(moved, rest)]
             Ma = Ma - Mab @ np.linalg.solve(M[np.ix_(rest, rest)], Mab.T)
         sub = np.ix_(moved, moved)
-        dt = _stable_step(K[sub], C[sub], Ma)
+        dt = stable_step(K[sub], C[sub], Ma)
         return STABILITY_MARGIN * dt, bodies[self.bodies[0][1]].name
 
     def describe(self, model):
@@ -296,6 +298,38 @@ class Mechanism:
                 slot_wrench(model, s, slot, wrench)
                 push_reaction(xipos, xfrc, self.ids[name], wrench)
 
+    def advance(self, model, state, until, step_bodies):
+        """Steps from ``state.step`` up to ``until`` of the mechanism and every
+        body (:mod:`meshwear.dynamics`): in the compiled loop
+        (:func:`meshwear.kernels.mechanism.advance_mechanism`), or a step at
+        a time through Python where MuJoCo's library cannot be called from
+        it. Returns None, or ``(step, code, body, report)``."""
+        from .dynamics import UNSTABLE
+
+        if self.calls is None:
+            for k in range(state.step, until):
+                if not self.step(model, state, k, lambda k: step_bodies(k, k + 1)):
+                    return k, UNSTABLE, -1, None
+            return None
+        surfaces = model.surfaces
+        report = np.zeros(2, np.int64)
+        bodies = tuple(body_arrays(model, body, s) for body, s in zip(model.bodies,
+                                                                      state.bodies))
+        motions = tuple(motion_arrays(model, body, s) for body, s in zip(model.bodies,
+                                                                         state.bodies))
+        start = state.step
+        k, what, b = advance_mechanism(
+            start, until, model.dt, self.calls, self.model._address, self.data._address,
+            self.compiled_arrays(), bodies, motions, self.body_riders, self.placements,
+            self.surface_riders, self.rests, self.rows, self.row_terms,
+            surfaces.compiled_planes(), surfaces.compiled_list(), surfaces.bounds,
+            surfaces.terms, report)
+        if not self.stable():
+            return start, UNSTABLE, -1, None
+        if what != DONE:
+            return k, what, b, report
+        return None
+
     def step(self, model, state, k, contact):
         """Step ``k`` of the mechanism and its riders: ``contact(k)`` takes
         the contact step of every body (the riders placed at ``k dt``).
@@ -367,6 +401,10 @@ class Mechanism:
         mujoco.mj_setState(m, d, np.asarray(values, float), mujoco.mjtState.mjSTATE_INTEGRATION)
         mujoco.mj_forward(m, d)
         self.place(model, state, state.time)
+
+    def columns(self):
+        """Its ``history.csv`` columns now (:meth:`joints`)."""
+        return self.joints()
 
     def joints(self):
         """History columns of the mechanism (docs/outputs.md): each hinge and

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import geometry, remesh, surfaces
+from .dynamics import OwnMotions
 from .kernels.contact import LAW_SLOTS, all_vertices, contact, make_law, rotation_entries
 from .kernels.counter_wear import wear_counter
 from .kernels.laws import code_of
@@ -19,9 +20,11 @@ from .kernels.nearest import face_frames
 from .motion import (BalancedMotion, FixedMotion, FreeMotion, GuidedMotion, MechanismMotion, Path,
                      PrescribedMotion)
 from .scene import SceneError
-from .stability import STABILITY_MARGIN, _contact_matrix, _stable_step, vertex_stiffness
+from .stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_stiffness
 from .surfaces.base import quaternion_matrix
 
+#: meshwear's own motions, the dynamics of a model without a mechanism
+OWN_MOTIONS = OwnMotions()
 #: ``run.dt = "auto"`` resolves a cycle of the motion into at least this many steps
 AUTO_STEPS_PER_CYCLE = 200
 #: ... and the whole run into at least this many
@@ -117,6 +120,12 @@ class Model:
     extent: float = 1.0
     #: the MuJoCo mechanism the riders move with (:mod:`meshwear.mechanism`), or None
     mechanism: object = None
+
+    @property
+    def dynamics(self):
+        """What moves the parts (:mod:`meshwear.dynamics`): the mechanism, or
+        meshwear's own motions."""
+        return self.mechanism if self.mechanism is not None else OWN_MOTIONS
 
     def __post_init__(self):
         steps = np.union1d(np.union1d(self.sample_steps, self.frame_steps), [self.n_steps])
@@ -685,8 +694,7 @@ def initial_state(model):
         if part is not None:
             m.attach(part)
     state = State(time=0.0, step=0, bodies=bodies, parts=parts)
-    if model.mechanism is not None:
-        model.mechanism.reset(model, state)
+    model.dynamics.reset(model, state)
     for body, s in zip(model.bodies, state.bodies):
         surfaces.update(model, body, s, 0.0)
     if model.quasi_static:
@@ -743,10 +751,9 @@ def stable_time_step(model):
     times :data:`STABILITY_MARGIN`. Returns ``(inf, None)`` when no body is
     integrated in time.
     """
-    limit = _stable_limit(model.bodies, model.law, model.slots)
-    if model.mechanism is not None:
-        limit = min(limit, model.mechanism.stable_limit(model.bodies, model.law, model.slots))
-    return limit
+    own = _stable_limit(model.bodies, model.law, model.slots)
+    moved = model.dynamics.stable_limit(model.bodies, model.law, model.slots)
+    return own if own[0] <= moved[0] else moved
 
 
 def _stable_limit(bodies, law, slots):
@@ -765,11 +772,11 @@ def _stable_limit(bodies, law, slots):
             C = np.array([[d.sum()]])
             M = np.array([[b.mass]])
         else:
-            K, C = _contact_matrix(k, b.reference_vertices), _contact_matrix(d, b.reference_vertices)
+            K, C = contact_matrix(k, b.reference_vertices), contact_matrix(d, b.reference_vertices)
             M = np.zeros((6, 6))
             M[:3, :3] = b.mass * np.eye(3)
             M[3:, 3:] = b.inertia
-        dt = _stable_step(K, C, M)
+        dt = stable_step(K, C, M)
         if dt < best:
             best, who = dt, b.name
     return STABILITY_MARGIN * best, who

@@ -34,12 +34,8 @@ class NumericalError(RuntimeError):
 def step(model, state):
     """Advance ``state`` by one time step of ``model``, in place: the Python
     reference of the compiled loop (:func:`advance` uses that)."""
-    if model.mechanism is not None:
-        if not model.mechanism.step(model, state, state.step,
-                                    partial(_step_bodies, model, state)):
-            raise NumericalError(model.mechanism.instability(model, state.time))
-    else:
-        _step_bodies(model, state, state.step)
+    if not model.dynamics.step(model, state, state.step, partial(_step_bodies, model, state)):
+        raise NumericalError(model.dynamics.instability(model, state.time))
     state.step += 1
     state.time = state.step * model.dt
 

@@ -17,7 +17,7 @@ def vertex_stiffness(body, law):
     return np.maximum(c, ct), np.maximum(d, dtan)
 
 
-def _contact_matrix(weights, r):
+def contact_matrix(weights, r):
     """sum_i w_i J_i^T J_i (6, 6) for J_i = [I, -[r_i]x]."""
     out = np.zeros((6, 6))
     w = weights.sum()
@@ -30,7 +30,7 @@ def _contact_matrix(weights, r):
     return out
 
 
-def _stable_step(K, C, M):
+def stable_step(K, C, M):
     """Smallest per-mode stability limit of the damped oscillator M x'' + C x' + K x = 0."""
     w, U = np.linalg.eigh(M)
     S = U @ np.diag(w ** -0.5) @ U.T

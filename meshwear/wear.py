@@ -505,10 +505,9 @@ def _jump(model, state, before, rates, jump, results, measures=None, window=1):
     state.step += jump * model.cycle_steps
     state.time = state.step * model.dt
     state.resolved = False
-    if model.mechanism is not None:
-        # the mechanism goes on from the state at the end of the resolved
-        # cycle, its clock moved on by the jump's whole cycles
-        model.mechanism.jumped(model, state, jump * model.cycle_steps * model.dt)
+    # (a mechanism goes on from its state at the end of the resolved cycle,
+    # its clock moved on by the jump's whole cycles)
+    model.dynamics.jumped(model, state, jump * model.cycle_steps * model.dt)
     # put every body where its path is at the new time (a steady sliding path
     # has moved on; a periodic one is back in phase), a guided one moved along
     # its axis as the jump's balance has it, and carry the stick anchors

@@ -35,9 +35,8 @@ class MemoryHistory:
             r["contact_points"].append(q["contact_points"])
             r["active"].append(len(s.active))
             r["resolved"].append(bool(state.resolved))
-            if model.mechanism is not None:
-                for key, value in model.mechanism.joints().items():
-                    r.setdefault(key, []).append(value)
+            for key, value in model.dynamics.columns().items():
+                r.setdefault(key, []).append(value)
 
     def on_frame(self, model, state):
         pass

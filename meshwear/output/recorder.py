@@ -79,7 +79,7 @@ class RunRecorder:
         Series = series_class(model)
         self.series = {b.name: Series(self.out_dir, b.name, b.faces, resume_until)
                        for b in model.bodies}
-        joints = tuple(model.mechanism.joints()) if model.mechanism is not None else ()
+        joints = tuple(model.dynamics.columns())
         self.history = HistoryWriter(self.out_dir / "history.csv", EXTRA_COLUMNS + joints,
                                      resume_until)
         # counter-surfaces: one frame if they stay put, else one per frame
@@ -173,11 +173,10 @@ def history_rows(model, state):
             q = part_quantities(model, state, m)
             rows.append(_row(state, surface.name, q, q["origin"], q["orientation"],
                              q["velocity"], q["angular_velocity"], q["wrench"]))
-    if model.mechanism is not None:
-        # the mechanism's joints and actuators, on every row of the sample
-        joints = model.mechanism.joints()
-        for row in rows:
-            row.update(joints)
+    # a mechanism's joints and actuators, on every row of the sample
+    joints = model.dynamics.columns()
+    for row in rows:
+        row.update(joints)
     return rows
 
 

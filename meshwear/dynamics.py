@@ -1,0 +1,82 @@
+"""How the parts of a run move: the dynamics seam (docs/model.md, "Dynamics").
+
+The step loop (:mod:`meshwear.stepper`, its Python reference
+:func:`meshwear.simulate.step`, the cycle jumps, checkpoints and outputs)
+moves the parts through one object, ``model.dynamics``, and does not care
+which it is. Two implement it:
+
+:class:`OwnMotions`
+    meshwear's own rigid-body motions (:mod:`meshwear.motion`: free,
+    guided, prescribed, fixed, the quasi-static balance), each body's inside
+    the compiled step loop, from the contact wrench it has just computed.
+:class:`meshwear.mechanism.Mechanism`
+    A MuJoCo mechanism: the parts' poses and velocities out of MuJoCo's
+    kinematics, the contact wrenches into MuJoCo's applied forces.
+
+The interface (a new engine is one more class):
+
+``advance(model, state, until, step_bodies)``
+    Take the steps from ``state.step`` up to ``until``; ``step_bodies(k0,
+    k1)`` takes steps ``k0`` to ``k1`` of every body in the compiled loop.
+    Returns None, or ``(k, code, body)`` for a step it could not take
+    (:mod:`meshwear.kernels.loop` codes, or :data:`UNSTABLE`).
+``step(model, state, k, contact)``
+    Step ``k`` in Python (the reference), ``contact(k)`` the contact step of
+    every body; False if the dynamics became unstable in it.
+``reset(model, state)``, ``jumped(model, state, duration)``
+    At the start of a run, and after a cycle jump moved the clock on.
+``get_state()``, ``set_state(values, model, state)``
+    Its own state for checkpoints (None: it has none beyond the parts').
+``columns()``, ``describe(model)``, ``stable_limit(bodies, law, slots)``
+    Its ``history.csv`` columns now, its lines in ``meshwear check``, and the
+    largest stable step of the parts it moves (s) and the part that sets it.
+``instability(model, t, until=None)``
+    The message of a step it found unstable.
+"""
+
+import numpy as np
+
+#: :meth:`advance`'s code for a step the dynamics found unstable
+UNSTABLE = -1
+
+
+class OwnMotions:
+    """meshwear's own motions: every body moves by its :mod:`meshwear.motion`
+    rule inside the compiled loop; bodies that share a worn counter-surface
+    take their steps in turn, one each."""
+
+    def advance(self, model, state, until, step_bodies):
+        if model.worn_counters and len(model.bodies) > 1:
+            for k in range(state.step, until):
+                step_bodies(k, k + 1)
+        else:
+            step_bodies(state.step, until)
+
+    def step(self, model, state, k, contact):
+        contact(k)
+        return True
+
+    def reset(self, model, state):
+        pass
+
+    def jumped(self, model, state, duration):
+        pass
+
+    def get_state(self):
+        return None
+
+    def set_state(self, values, model, state):
+        pass
+
+    def columns(self):
+        return {}
+
+    def describe(self, model):
+        return []
+
+    def stable_limit(self, bodies, law, slots):
+        # meshwear.model.stable_time_step bounds the bodies' own motions
+        return np.inf, None
+
+    def instability(self, model, t, until=None):
+        return f"the step from t = {t:.6g} s became unstable"
