@@ -86,6 +86,11 @@ def save(path, model, state, wall_time):
     if own is not None:
         # a mechanism's (MuJoCo's whole integration state): bit for bit on resuming
         arrays["dynamics_state"] = own
+        refs = getattr(model.dynamics, "refs", None)
+        if refs is not None:
+            arrays["dynamics_refs"] = refs
+            arrays["dynamics_ref_times"] = model.dynamics.ref_times
+            arrays["dynamics_cull"] = np.array([float(model.cull), model.dynamics.refreshes])
     for m, part in enumerate(state.parts):
         if part is not None:
             for name in _PART_ARRAYS:
@@ -178,6 +183,11 @@ def load(path, model, state):
                 model.surfaces.per_vertex[m].rebin()
         if model.dynamics.get_state() is not None:
             model.dynamics.set_state(data["dynamics_state"], model, state)
+            if "dynamics_refs" in data:
+                d = model.dynamics
+                d.refs, d.ref_times = data["dynamics_refs"].copy(), data["dynamics_ref_times"].copy()
+                cull, d.refreshes = data["dynamics_cull"]
+                object.__setattr__(model, "cull", bool(cull))
     except (KeyError, ValueError) as err:
         raise SceneError(model.scene.source, "", f"{path} was written by another version of "
                          f"meshwear ({err}); run without --resume to start again") from None

@@ -28,13 +28,21 @@ import logging
 
 import numpy as np
 
-from .kernels.loop import DONE
-from .kernels.mechanism import (advance_mechanism, place_body, place_surface, push_body,
-                                push_reaction, slot_wrench as _slot_wrench)
+from .kernels.loop import DONE, REFRESH
+from .kernels.mechanism import (advance_mechanism, needs_refresh as _needs_refresh, place_body,
+                                place_surface, push_body, push_reaction,
+                                slot_wrench as _slot_wrench)
 from .packing import body_arrays, motion_arrays
 from .scene import SceneError
 from .stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_stiffness
 from .surfaces.base import quaternion_matrix
+
+
+#: the first steps of a mechanism try the bodies' active sets: if more than
+#: :data:`TRIAL_REFRESHES` refreshes were needed in them, every vertex is
+#: checked at every step from then on (riders fast against their margins: a
+#: disc turning under a pin refreshes every few steps)
+TRIAL_STEPS, TRIAL_REFRESHES = 200, 20
 
 
 def _mujoco(source):
@@ -154,6 +162,60 @@ class Mechanism:
                                      self.bodies], dtype=np.int64).reshape(-1, 2)
         self.placements = np.array([p for *_, p in self.bodies], float).reshape(-1, 13)
         self.calls = _c_functions(self.mujoco)
+        #: each riding surface's frame now, at each body's last refresh, and its lever
+        self.world = np.zeros((S, 12))
+        self.levers = np.zeros(S)
+        for r, (surface, *_) in enumerate(self.surfaces):
+            points = getattr(surface, "vertices", None)
+            if points is None:
+                points = surface.drawing(1.0)[0]
+            self.levers[r] = float(np.linalg.norm(points, axis=1).max()) if len(points) else 0.0
+        self.refs = None
+
+    # ------------------------------------------------------------ active sets
+    def sync_refs(self, model, state, k):
+        """Before step ``k``: each body's riding surfaces' frames at its last
+        active-set refresh (recorded when it was refreshed now; one of an
+        earlier time not recorded, a checkpoint's, is forced anew), and the
+        active sets given up if they do not pay (:data:`TRIAL_STEPS`)."""
+        B = len(state.bodies)
+        if self.refs is None or len(self.refs) != B:
+            self.refs = np.zeros((B, len(self.surfaces), 12))
+            self.ref_times = np.full(B, np.nan)
+            self.refreshes = 0
+        if model.cull and k >= TRIAL_STEPS and self.refreshes > TRIAL_REFRESHES:
+            # riders move so fast against their margins that the active sets
+            # cost more than they save: every vertex is checked from here on
+            self.give_up_active_sets(model, state)
+        if not model.cull:
+            return
+        for b, s in enumerate(state.bodies):
+            if self.ref_times[b] != s.cull[1]:
+                if s.cull[1] == k * model.dt:
+                    self.refreshed(b, s)
+                else:
+                    s.cull[0] = 0.0
+
+    def give_up_active_sets(self, model, state):
+        """Every vertex of every body checked at every step from now on."""
+        object.__setattr__(model, "cull", False)
+        for s in state.bodies:
+            s.active = np.arange(len(s.vertices), dtype=np.int64)
+            s.active_wear = s.wear_depth.copy()
+
+    def refreshed(self, b, s):
+        """Body ``b``'s active set was refreshed now."""
+        self.refs[b] = self.world
+        self.ref_times[b] = s.cull[1]
+        self.refreshes += 1
+
+    def needs_refresh(self, model, b, s, t):
+        """:func:`meshwear.kernels.mechanism.needs_refresh` of body ``b``."""
+        surfaces = model.surfaces
+        return model.cull and _needs_refresh(
+            body_arrays(model, model.bodies[b], s), surfaces.bounds, surfaces.terms, float(t),
+            model.dt, np.zeros((2, 3)), self.world, self.refs[b], self.levers, self.rows,
+            self.row_terms)
 
     def compiled_arrays(self):
         """MuJoCo's arrays the compiled loop reads and writes (views of its data)."""
@@ -267,7 +329,8 @@ class Mechanism:
         by row, then position): a steady turn at the body's angular velocity
         and a steady velocity (:func:`meshwear.kernels.mechanism.place_surface`)."""
         xpos, _, xmat, cvel, com, root = self._arrays()
-        place_surface(xpos, xmat, cvel, com, root, self.ids[name], rest, float(t), array, terms)
+        place_surface(xpos, xmat, cvel, com, root, self.ids[name], rest, float(t), array, terms,
+                      np.zeros(12))
 
     def place(self, model, state, t):
         """Put every rider where MuJoCo's last kinematics have its body (at ``t``)."""
@@ -275,9 +338,9 @@ class Mechanism:
         for body, index, name, placement in self.bodies:
             place_body(xpos, xquat, xmat, cvel, com, root, self.ids[name], placement,
                        state.bodies[index].pose)
-        for surface, slot, name, rest in self.surfaces:
+        for r, (surface, slot, name, rest) in enumerate(self.surfaces):
             place_surface(xpos, xmat, cvel, com, root, self.ids[name], rest, float(t),
-                          surface.motion.array, surface.motion.path.terms)
+                          surface.motion.array, surface.motion.path.terms, self.world[r])
         if self.surfaces:
             model.surfaces.mechanism_moved(t)
 
@@ -311,23 +374,41 @@ class Mechanism:
                 if not self.step(model, state, k, lambda k: step_bodies(k, k + 1)):
                     return k, UNSTABLE, -1, None
             return None
+        from .surfaces import update
+
         surfaces = model.surfaces
         report = np.zeros(2, np.int64)
-        bodies = tuple(body_arrays(model, body, s) for body, s in zip(model.bodies,
-                                                                      state.bodies))
-        motions = tuple(motion_arrays(model, body, s) for body, s in zip(model.bodies,
-                                                                         state.bodies))
-        start = state.step
-        k, what, b = advance_mechanism(
-            start, until, model.dt, self.calls, self.model._address, self.data._address,
-            self.compiled_arrays(), bodies, motions, self.body_riders, self.placements,
-            self.surface_riders, self.rests, self.rows, self.row_terms,
-            surfaces.compiled_planes(), surfaces.compiled_list(), surfaces.bounds,
-            surfaces.terms, report)
-        if not self.stable():
-            return start, UNSTABLE, -1, None
-        if what != DONE:
-            return k, what, b, report
+        start = k = state.step
+        last = None
+        while k < until:
+            self.sync_refs(model, state, k)
+            # (the trial of the active sets ends at a step of its own)
+            stop = TRIAL_STEPS if k < TRIAL_STEPS < until and model.cull else until
+            # (a refresh rebinds a body's arrays: packed anew)
+            bodies = tuple(body_arrays(model, body, s) for body, s in zip(model.bodies,
+                                                                          state.bodies))
+            motions = tuple(motion_arrays(model, body, s) for body, s in zip(model.bodies,
+                                                                             state.bodies))
+            k, what, b = advance_mechanism(
+                k, stop, model.dt, self.calls, self.model._address, self.data._address,
+                self.compiled_arrays(), bodies, motions, self.body_riders, self.placements,
+                self.surface_riders, self.rests, self.rows, self.row_terms, model.cull,
+                self.world, self.refs, self.levers, surfaces.compiled_planes(),
+                surfaces.compiled_list(), surfaces.bounds, surfaces.terms, report)
+            if not self.stable():
+                return start, UNSTABLE, -1, None
+            if what == REFRESH and last == (k, b):
+                # a rider moves farther than the margin in one step: no
+                # active set can follow it
+                self.give_up_active_sets(model, state)
+            elif what == REFRESH:
+                s = state.bodies[b]
+                s.cull[0] = 0.0                 # (the riders' moves decided it: forced)
+                update(model, model.bodies[b], s, k * model.dt)
+                self.refreshed(b, s)
+                last = (k, b)
+            elif what != DONE:
+                return k, what, b, report
         return None
 
     def step(self, model, state, k, contact):
@@ -336,8 +417,16 @@ class Mechanism:
         Returns False if MuJoCo found its accelerations non-finite in the
         step (it then resets itself: the run cannot go on)."""
         mujoco, m, d = self.mujoco, self.model, self.data
+        self.sync_refs(model, state, k)
+        for b, s in enumerate(state.bodies):
+            if self.needs_refresh(model, b, s, k * model.dt):
+                s.cull[0] = 0.0         # the step's own check refreshes it
         mujoco.mj_step1(m, d)
         contact(k)
+        if model.cull:
+            for b, s in enumerate(state.bodies):
+                if self.ref_times[b] != s.cull[1]:
+                    self.refreshed(b, s)
         self.push(model, state)
         mujoco.mj_step2(m, d)
         if not self.stable():
@@ -384,8 +473,11 @@ class Mechanism:
 
     def reset(self, model, state):
         """MuJoCo back at its initial state (the keyframe, or the model's
-        reference pose at rest), the controls set, the riders there."""
+        reference pose at rest), the controls set, the riders there; the
+        bodies' active sets on trial again."""
         self._start()
+        object.__setattr__(model, "cull", True)
+        self.refs = None
         self.place(model, state, 0.0)
 
     def get_state(self):

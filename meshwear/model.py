@@ -371,9 +371,7 @@ def build_model(scene):
                  surfaces=surface_set,
                  quasi_static=quasi_static, dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
                  frame_steps=_even_steps(n_steps, run.frames), period=period,
-                 cycle_steps=cycle_steps, mechanism=mechanism,
-                 # a mechanism's motion is not known ahead: every vertex is checked each step
-                 cull=mechanism is None)
+                 cycle_steps=cycle_steps, mechanism=mechanism)
 
 
 def _ride(mechanism, surface, index, name, t):

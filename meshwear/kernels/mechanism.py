@@ -10,7 +10,8 @@ import numpy as np
 from numba import njit
 
 from .contact import FORCE, rotation_entries
-from .loop import DONE, advance_body
+from .frames import moved_since_refresh, step_motion
+from .loop import DONE, REFRESH, advance_body
 from .rigid import STEADY
 
 
@@ -97,12 +98,13 @@ def place_body(xpos, xquat, xmat, cvel, subtree_com, rootid, body, placement, po
 
 
 @njit(cache=True)
-def place_surface(xpos, xmat, cvel, subtree_com, rootid, body, rest, t, motion, terms):
+def place_surface(xpos, xmat, cvel, subtree_com, rootid, body, rest, t, motion, terms, world):
     """Write a counter-surface's ``motion`` (19,) and path ``terms`` (1, 9)
     (:mod:`meshwear.kernels.frames`) so its frame at ``t``, and the velocity
     field about it, are those of MuJoCo body ``body`` with the surface at
     ``rest`` (12,: rotation row by row, then position, in the body's frame):
-    a steady turn at the body's angular velocity and a steady velocity."""
+    a steady turn at the body's angular velocity and a steady velocity; and
+    ``world`` (12,) its frame at ``t`` (rotation row by row, origin)."""
     vx, vy, vz, wx, wy, wz = _body_velocity(xpos, cvel, subtree_com, rootid, body)
     R = xmat[body]
     # the surface's frame in the world: Rw = R Rc, origin p + R pc
@@ -126,13 +128,15 @@ def place_surface(xpos, xmat, cvel, subtree_com, rootid, body, rest, t, motion, 
             k * ex * ez - s * ey, k * ey * ez + s * ex, c + k * ez * ez)
     for r in range(3):
         for col in range(3):
-            world = (R[3 * r] * rest[col] + R[3 * r + 1] * rest[3 + col]
-                     + R[3 * r + 2] * rest[6 + col])
-            motion[3 * r + col] = world
+            motion[3 * r + col] = (R[3 * r] * rest[col] + R[3 * r + 1] * rest[3 + col]
+                                   + R[3 * r + 2] * rest[6 + col])
+    for j in range(9):
+        world[j] = motion[j]
     for col in range(3):
         a0, a1, a2 = motion[col], motion[3 + col], motion[6 + col]
         for r in range(3):
             motion[3 * r + col] = turn[3 * r] * a0 + turn[3 * r + 1] * a1 + turn[3 * r + 2] * a2
+    world[9], world[10], world[11] = xpos[body, 0] + ax, xpos[body, 1] + ay, xpos[body, 2] + az
     sx = xpos[body, 0] + ax - ux * t
     sy = xpos[body, 1] + ay - uy * t
     sz = xpos[body, 2] + az - uz * t
@@ -144,6 +148,46 @@ def place_surface(xpos, xmat, cvel, subtree_com, rootid, body, rest, t, motion, 
         terms[0, j] = 0.0
     terms[0, 0] = STEADY
     terms[0, 1], terms[0, 2], terms[0, 3] = ux, uy, uz
+
+
+@njit(cache=True)
+def rider_shift(world, ref, levers, rows, row_terms, dt):
+    """Upper bound (m) on how far a point of any counter-surface riding on
+    the mechanism has moved since a body's active set was refreshed (its
+    frames then, ``ref`` (S, 12), against ``world`` (S, 12) now; ``levers``
+    (S,) the farthest of its points from its frame's origin), plus one step
+    of its motion (``rows``, ``row_terms``: its angular and linear velocity):
+    the origin's displacement plus the lever times the rotation's change
+    (its Frobenius norm bounds how far it moves a unit vector)."""
+    out = 0.0
+    for r in range(world.shape[0]):
+        d0 = world[r, 9] - ref[r, 9]
+        d1 = world[r, 10] - ref[r, 10]
+        d2 = world[r, 11] - ref[r, 11]
+        turned = 0.0
+        for j in range(9):
+            turned += (world[r, j] - ref[r, j]) ** 2
+        u = row_terms[r, 0]
+        speed = np.sqrt(u[1] * u[1] + u[2] * u[2] + u[3] * u[3]) + abs(rows[r, 15]) * levers[r]
+        out = max(out, np.sqrt(d0 * d0 + d1 * d1 + d2 * d2) + levers[r] * np.sqrt(turned)
+                  + speed * dt)
+    return out
+
+
+@njit(cache=True)
+def needs_refresh(body, bounds, terms, t, dt, buffer, world, ref, levers, rows, row_terms):
+    """The active set of a body on a mechanism must be refreshed before the
+    step at ``t``: :func:`meshwear.kernels.loop._needs_refresh`, with the
+    moves of the counter-surfaces riding on the mechanism measured since its
+    refresh (:func:`rider_shift`) instead of foreseen."""
+    pose, wear_depth, active, active_wear, cull, radius = (body[1], body[9], body[14], body[15],
+                                                           body[16], body[19])
+    if cull[0] == 0.0:
+        return True
+    return (moved_since_refresh(pose, cull, radius, bounds, terms, t, wear_depth, active,
+                                active_wear, buffer)
+            + step_motion(pose, radius, bounds, terms, t, dt, buffer)
+            + rider_shift(world, ref, levers, rows, row_terms, dt) >= cull[0])
 
 
 @njit(cache=True)
@@ -180,8 +224,8 @@ def push_reaction(xipos, xfrc, body, wrench):
 
 @njit(cache=True)
 def advance_mechanism(k, stop, dt, calls, m, d, mj, bodies, motions, body_riders, placements,
-                      surface_riders, rests, rows, row_terms, planes, surfaces, bounds, terms,
-                      report):
+                      surface_riders, rests, rows, row_terms, cull, world, refs, levers, planes,
+                      surfaces, bounds, terms, report):
     """Steps ``k`` up to ``stop`` of a mechanism and every body, without
     returning to Python (:meth:`meshwear.mechanism.Mechanism.step` is the
     reference it must match to the last bit). Returns ``(step, what, body)``:
@@ -206,12 +250,23 @@ def advance_mechanism(k, stop, dt, calls, m, d, mj, bodies, motions, body_riders
         mechanism, (S, 12) its rest frame in that body's, and the (S, 19)
         motions and (S, 1, 9) terms the surfaces' tuples read (a uniform
         plane's are copied into ``planes``).
+    cull, world, refs, levers
+        Whether bodies keep active sets; (S, 12) each riding surface's frame now, (B, S, 12) its frames at
+        each body's last active-set refresh and (S,) its lever
+        (:func:`rider_shift`): a body whose active set must be refreshed
+        before step ``k`` stops the loop there, with nothing of the step
+        done (:data:`meshwear.kernels.loop.REFRESH`).
     """
     xpos, xquat, xmat, cvel, com, xipos, xfrc, rootid = mj
     mj_step1, mj_step2, kinematics, com_pos, com_vel = calls
     n_planes = planes[0].shape[0]
     wrench = np.zeros(6)
+    buffer = np.zeros((2, 3))
     while k < stop:
+        for b in range(len(bodies)):
+            if cull and needs_refresh(bodies[b], bounds, terms, k * dt, dt, buffer, world,
+                                      refs[b], levers, rows, row_terms):
+                return k, REFRESH, b
         mj_step1(m, d)
         for b in range(len(bodies)):
             reached, what = advance_body(k, k + 1, dt, False, False, bodies[b], motions[b],
@@ -240,7 +295,7 @@ def advance_mechanism(k, stop, dt, calls, m, d, mj, bodies, motions, body_riders
                        placements[r], bodies[body_riders[r, 0]][1])
         for r in range(surface_riders.shape[0]):
             place_surface(xpos, xmat, cvel, com, rootid, surface_riders[r, 1], rests[r], t,
-                          rows[r], row_terms[r])
+                          rows[r], row_terms[r], world[r])
             slot = surface_riders[r, 0]
             if slot < n_planes:
                 for j in range(19):

@@ -82,6 +82,11 @@ class SurfaceSet:
         for j, s in enumerate(slots):
             self.bounds[j] = s.bounds()
             self.terms[j, :len(s.motion.terms)] = s.motion.terms
+            if getattr(s, "rider", False) and not s.uniform:
+                # a mechanism moves it: its moves since a refresh are
+                # measured, not foreseen (meshwear.mechanism.rider_shift)
+                self.bounds[j] = 0.0
+                self.terms[j] = 0.0
         self._compiled_planes = None
 
     def compiled_planes(self):
@@ -125,7 +130,7 @@ class SurfaceSet:
         kernels read it, and put the planes at ``t``."""
         compiled = getattr(self, "_compiled_planes", None)
         for j, s in enumerate(self.slots):
-            if getattr(s, "rider", False):
+            if getattr(s, "rider", False) and s.uniform:
                 self.terms[j, :1] = s.motion.terms
                 if j < len(self.uniform) and compiled is not None:
                     compiled[1][j] = s.motion.array
