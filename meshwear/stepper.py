@@ -5,7 +5,11 @@ The loop runs whole spans of steps of one body inside numba. It returns to
 Python for an active-set refresh (python-fcl, numpy: done by the reference
 step :func:`meshwear.simulate.step_body`, or :func:`meshwear.simulate.finish_step`
 for the rest of a quasi-static step), for a load nothing can carry, and at the
-``until`` step the caller asks for (outputs, checkpoints, progress).
+``until`` step the caller asks for (outputs, checkpoints, progress). What
+moves the bodies between those is the model's dynamics
+(:mod:`meshwear.dynamics`): meshwear's own motions step each body's span
+here, a MuJoCo mechanism steps them all with itself in its own compiled
+loop (:mod:`meshwear.mechanism`).
 """
 
 import numpy as np
