@@ -18,6 +18,7 @@ from meshwear.model import build_model, initial_state
 from meshwear.output.memory import MemoryHistory
 from meshwear.scene import SceneError, load_scene
 from meshwear.simulate import run
+from test_resume import _KillAt, _Stop
 
 pytest.importorskip("mujoco")
 
@@ -129,29 +130,13 @@ def test_a_mechanism_run_resumes_bit_for_bit(tmp_path):
     full = run(model, initial_state(model))
     saver = checkpoint.Checkpointer(tmp_path, every=0.0)
     with pytest.raises(_Stop):
-        run(model, initial_state(model), observers=[_StopAt(0.02)], checkpoint=saver)
+        run(model, initial_state(model), observers=[_KillAt(0.02)], checkpoint=saver)
     resumed = initial_state(model)
     checkpoint.load(saver.path, model, resumed)
     assert 0.0 < resumed.time <= 0.02
     run(model, resumed)
     assert np.array_equal(resumed.bodies[0].wear_depth, full.bodies[0].wear_depth)
     assert np.array_equal(resumed.bodies[0].pose, full.bodies[0].pose)
-
-
-class _Stop(Exception):
-    pass
-
-
-class _StopAt:
-    def __init__(self, time_):
-        self.time = time_
-
-    def on_frame(self, model, state):
-        pass
-
-    def on_sample(self, model, state):
-        if state.time >= self.time:
-            raise _Stop
 
 
 @pytest.mark.parametrize("key, value, message", [
