@@ -90,7 +90,8 @@ def save(path, model, state, wall_time):
         if refs is not None:
             arrays["dynamics_refs"] = refs
             arrays["dynamics_ref_times"] = model.dynamics.ref_times
-            arrays["dynamics_cull"] = np.array([float(model.cull), model.dynamics.refreshes])
+            arrays["dynamics_cull"] = np.array([float(model.cull), model.dynamics.refreshes,
+                                                model.dynamics.window])
     for m, part in enumerate(state.parts):
         if part is not None:
             for name in _PART_ARRAYS:
@@ -186,7 +187,8 @@ def load(path, model, state):
             if "dynamics_refs" in data:
                 d = model.dynamics
                 d.refs, d.ref_times = data["dynamics_refs"].copy(), data["dynamics_ref_times"].copy()
-                cull, d.refreshes = data["dynamics_cull"]
+                cull, d.refreshes, window = data["dynamics_cull"]
+                d.window = int(window)
                 object.__setattr__(model, "cull", bool(cull))
     except (KeyError, ValueError) as err:
         raise SceneError(model.scene.source, "", f"{path} was written by another version of "

@@ -335,7 +335,9 @@ def _check(scene_path, overrides=()):
               else "no stability limit (nothing integrated in time)")
     print(f"  dt {model.dt:.3g} s, {stable}, {model.n_steps} steps, "
           f"{len(model.frame_steps)} frames, {len(model.sample_steps)} history rows")
-    for line in model.dynamics.describe(model):
+    from .model import initial_state
+
+    for line in model.dynamics.describe(model, initial_state(model)):
         print(f"  {line}")
     if model.cycle_steps:
         cycles = model.n_steps / model.cycle_steps

@@ -27,9 +27,15 @@ The interface (a new engine is one more class):
     At the start of a run, and after a cycle jump moved the clock on.
 ``get_state()``, ``set_state(values, model, state)``
     Its own state for checkpoints (None: it has none beyond the parts').
-``columns()``, ``describe(model)``, ``stable_limit(bodies, law, slots)``
-    Its ``history.csv`` columns now, its lines in ``meshwear check``, and the
+``columns()``, ``describe(model, state)``, ``stable_limit(bodies, law, slots)``
+    Its ``history.csv`` columns now, its lines in ``meshwear check`` (the run
+    about to start from ``state``), and the
     largest stable step of the parts it moves (s) and the part that sets it.
+``watched_limit(model, state)``
+    The largest stable step of the contacts its parts can make before their
+    next active-set refresh (their vertices within reach of a surface in
+    ``state``): a ``run.dt`` above ``stable_limit`` but within this one is
+    taken, watched at every refresh (inf: it takes none).
 ``instability(model, t, until=None)``
     The message of a step it found unstable.
 """
@@ -71,11 +77,14 @@ class OwnMotions:
     def columns(self):
         return {}
 
-    def describe(self, model):
+    def describe(self, model, state):
         return []
 
     def stable_limit(self, bodies, law, slots):
         # meshwear.model.stable_time_step bounds the bodies' own motions
+        return np.inf, None
+
+    def watched_limit(self, model, state):
         return np.inf, None
 
     def instability(self, model, t, until=None):

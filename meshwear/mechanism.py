@@ -38,10 +38,11 @@ from .stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_sti
 from .surfaces.base import quaternion_matrix
 
 
-#: the first steps of a mechanism try the bodies' active sets: if more than
-#: :data:`TRIAL_REFRESHES` refreshes were needed in them, every vertex is
-#: checked at every step from then on (riders fast against their margins: a
-#: disc turning under a pin refreshes every few steps)
+#: the bodies' active sets on a mechanism are on trial in windows of at least
+#: :data:`TRIAL_STEPS` steps (the first one exactly that): if more than
+#: :data:`TRIAL_REFRESHES` refreshes per that many steps were needed in one,
+#: every vertex is checked at every step from then on (riders fast against
+#: their margins: a disc turning under a pin refreshes every few steps)
 TRIAL_STEPS, TRIAL_REFRESHES = 200, 20
 
 
@@ -142,6 +143,10 @@ class Mechanism:
         #: (part, state index, MuJoCo body id, placement) of the riders, set by the model
         self.bodies, self.surfaces = [], []
         self._wrench = np.zeros(6)
+        #: the riders' stable step over every vertex (set by the model), the
+        #: message of a run.dt above it that the active sets no longer hold
+        #: (:meth:`watch`), and whether a refresh is to be checked
+        self.strict, self.failed, self.due = np.inf, None, False
 
     # ------------------------------------------------------------ set-up
     def finish(self):
@@ -182,11 +187,15 @@ class Mechanism:
         if self.refs is None or len(self.refs) != B:
             self.refs = np.zeros((B, len(self.surfaces), 12))
             self.ref_times = np.full(B, np.nan)
-            self.refreshes = 0
-        if model.cull and k >= TRIAL_STEPS and self.refreshes > TRIAL_REFRESHES:
-            # riders move so fast against their margins that the active sets
-            # cost more than they save: every vertex is checked from here on
-            self.give_up_active_sets(model, state)
+            self.refreshes, self.window = 0, k
+        if model.cull and k - self.window >= TRIAL_STEPS:
+            if self.refreshes * TRIAL_STEPS > TRIAL_REFRESHES * (k - self.window):
+                # riders move so fast against their margins that the active
+                # sets cost more than they save: every vertex is checked from
+                # here on
+                self.give_up_active_sets(model, state)
+            else:
+                self.refreshes, self.window = 0, k
         if not model.cull:
             return
         for b, s in enumerate(state.bodies):
@@ -196,8 +205,44 @@ class Mechanism:
                 else:
                     s.cull[0] = 0.0
 
+    def watched_limit(self, model, state):
+        """The riders' stable step over their active sets in ``state``
+        (:meth:`stable_limit`), and the body that sets it."""
+        return self.stable_limit(model.bodies, model.law, model.slots, state.bodies)
+
+    def watch(self, model, state, t):
+        """A ``run.dt`` above the bound of every vertex at once
+        (:meth:`stable_limit`) holds only while the riders' active sets are
+        stiff enough for it: checked at every refresh. False, with the
+        message kept for :meth:`instability`, where they are not (or were
+        given up: every vertex may then press)."""
+        if self.failed is None and model.dt > self.strict:
+            if not model.cull:
+                self.failed = (
+                    f"run.dt: {model.dt:.6g} s is above the stability limit of every vertex "
+                    f"of the riders pressing at once ({self.strict:.6g} s), which a run can "
+                    "only take while its riders keep active sets, and this one gave them up "
+                    "(its riders move too far against their margins in a step); shorten "
+                    "run.dt to that limit")
+            else:
+                limit, who = self.watched_limit(model, state)
+                if model.dt > limit:
+                    self.failed = (
+                        f"run.dt: {model.dt:.6g} s is above the stability limit of the "
+                        f"contact of body {who!r} at t = {t:.6g} s ({limit:.6g} s "
+                        "over its vertices within reach of a surface now); shorten run.dt")
+        return self.failed is None
+
+    def watched(self, model, state, k):
+        """:meth:`watch` once after each refresh (and giving up), before step ``k``."""
+        if not self.due:
+            return self.failed is None
+        self.due = False
+        return self.watch(model, state, k * model.dt)
+
     def give_up_active_sets(self, model, state):
         """Every vertex of every body checked at every step from now on."""
+        self.due = True
         object.__setattr__(model, "cull", False)
         for s in state.bodies:
             s.active = np.arange(len(s.vertices), dtype=np.int64)
@@ -208,6 +253,7 @@ class Mechanism:
         self.refs[b] = self.world
         self.ref_times[b] = s.cull[1]
         self.refreshes += 1
+        self.due = True
 
     def needs_refresh(self, model, b, s, t):
         """:func:`meshwear.kernels.mechanism.needs_refresh` of body ``b``."""
@@ -238,14 +284,19 @@ class Mechanism:
                            self.ids[name])
         return J
 
-    def stable_limit(self, bodies, law, slots):
+    def stable_limit(self, bodies, law, slots, states=None):
         """Largest stable step (s) of the riders' contacts in the mechanism,
         and the body that sets it: as :func:`meshwear.model.stable_time_step`
         but in the mechanism's joint space, ``K = sum J^T K_c J`` over every
         rider and every surface it may press on (``J`` the rider's motion
         relative to the surface's body; the world for a surface not on the
         mechanism) against MuJoCo's joint-space mass matrix at the start. A
-        joint takes away modes, so this is larger than the free body's."""
+        joint takes away modes, so this is larger than the free body's.
+
+        ``states`` (the bodies' states): the same bound over each rider's
+        active set only (its vertices within reach of a surface), at its pose
+        and MuJoCo's mass matrix now: the limit of the contacts the riders can
+        make before their next active-set refresh (:meth:`watch`)."""
 
         m, d = self.model, self.data
         if not self.bodies or m.nv == 0:
@@ -255,9 +306,14 @@ class Mechanism:
         fixed = max(0, slots - len(on))
         for _, index, name, _ in self.bodies:
             b = bodies[index]
-            pose = b.initial_pose
-            r = b.reference_vertices @ quaternion_matrix(pose[3:7]).T
             k, c = vertex_stiffness(b, law)
+            if states is None:
+                pose, r = b.initial_pose, b.reference_vertices
+            else:
+                s = states[index]
+                pose, r = s.pose, s.vertices[s.active]
+                k, c = k[s.active], c[s.active]
+            r = r @ quaternion_matrix(pose[3:7]).T
             Kb, Cb = contact_matrix(k, r), contact_matrix(c, r)
             Jb = self.jacobian(name, pose[0:3])
             for J in [Jb - self.jacobian(s, pose[0:3]) for s in on] + [Jb] * max(fixed, 1 - len(on)):
@@ -282,10 +338,11 @@ class Mechanism:
         dt = stable_step(K[sub], C[sub], Ma)
         return STABILITY_MARGIN * dt, bodies[self.bodies[0][1]].name
 
-    def describe(self, model):
+    def describe(self, model, state):
         """Lines for ``meshwear check``: the MuJoCo model, its joints and
-        actuators, the parts meshwear handles on its bodies, the two
-        stability limits."""
+        actuators, the parts meshwear handles on its bodies, the stability
+        limits of their contact (every vertex; those within reach of a
+        surface in ``state``, the run's start)."""
         m = self.model
         mujoco = self.mujoco
         kinds = {int(v): k.removeprefix("mjJNT_").lower()
@@ -304,9 +361,12 @@ class Mechanism:
             lines.append(f"  body {name!r} ({self.mass(name):.6g} kg) carries "
                          + ", ".join(repr(p) for p in parts))
         contact, _ = self.stable_limit(model.bodies, model.law, model.slots)
+        reach, _ = self.watched_limit(model, state)
         lines.append(f"  MuJoCo timestep in the file {self.file_timestep:.3g} s; the coupled "
                      f"step {model.dt:.3g} s; the riders' contact in the joints is stable up to "
-                     f"{contact:.3g} s")
+                     f"{contact:.3g} s with every vertex pressing at once, {reach:.3g} s with "
+                     "the vertices within reach of a surface at the start (a run.dt between "
+                     "the two is checked at every active-set refresh)")
         return lines
 
     # ------------------------------------------------------------ coupling
@@ -382,6 +442,8 @@ class Mechanism:
         last = None
         while k < until:
             self.sync_refs(model, state, k)
+            if not self.watched(model, state, k):
+                return k, UNSTABLE, -1, None
             # (the trial of the active sets ends at a step of its own)
             stop = TRIAL_STEPS if k < TRIAL_STEPS < until and model.cull else until
             # (a refresh rebinds a body's arrays: packed anew)
@@ -427,6 +489,8 @@ class Mechanism:
             for b, s in enumerate(state.bodies):
                 if self.ref_times[b] != s.cull[1]:
                     self.refreshed(b, s)
+        if not self.watched(model, state, k):
+            return False
         self.push(model, state)
         mujoco.mj_step2(m, d)
         if not self.stable():
@@ -445,7 +509,10 @@ class Mechanism:
 
     def instability(self, model, t, until=None):
         """The message of a step MuJoCo found unstable at ``t`` (or between
-        ``t`` and ``until``)."""
+        ``t`` and ``until``), or of a ``run.dt`` the riders' contact
+        outgrew (:meth:`watch`)."""
+        if self.failed is not None:
+            return f"{self.source}: {self.failed}"
         when = f"step from t = {t:.6g} s" if until is None else (
             f"steps from t = {t:.6g} s to {until:.6g} s")
         return (f"mechanism {self.path.name}: MuJoCo's accelerations became non-finite in the "
@@ -478,6 +545,7 @@ class Mechanism:
         self._start()
         object.__setattr__(model, "cull", True)
         self.refs = None
+        self.failed, self.due = None, True
         self.place(model, state, 0.0)
 
     def get_state(self):

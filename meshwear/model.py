@@ -353,7 +353,8 @@ def build_model(scene):
     slots = plane_array.shape[0] + len(surface_set.per_vertex)
     limit = _stable_limit(bodies, law, slots)[0]
     if mechanism is not None:
-        limit = min(limit, mechanism.stable_limit(bodies, law, slots)[0])
+        mechanism.strict = mechanism.stable_limit(bodies, law, slots)[0]
+        limit = min(limit, mechanism.strict)
         limit = min(limit, mechanism.file_timestep) if scene.run.dt == "auto" else limit
     dt, n_steps, cycle_steps = _timing(scene, period, limit)
     law[LAW_SLOTS.index("dt")] = dt
@@ -802,13 +803,32 @@ def check_time_step(model):
                              f"extent ({b.depth_limit / IMPACT_DEPTH:.3g} m): no contact can "
                              "stop it within the body; lower the speed or run.dt")
     limit, who = stable_time_step(model)
-    if model.dt > limit:
-        asked = model.scene.run.dt
-        rounded = ("" if asked == "auto" or np.isclose(asked, model.dt, rtol=1e-12, atol=0.0)
-                   else f" (rounded to {model.dt:.6g} s for whole steps per cycle)")
+    if model.dt <= limit:
+        return limit
+    asked = model.scene.run.dt
+    rounded = ("" if asked == "auto" or np.isclose(asked, model.dt, rtol=1e-12, atol=0.0)
+               else f" (rounded to {model.dt:.6g} s for whole steps per cycle)")
+    own = _stable_limit(model.bodies, model.law, model.slots)[0]
+    if model.dt <= own:
+        # a mechanism's riders: a step above the bound of every vertex
+        # pressing at once holds while the vertices within reach of a
+        # surface allow it (checked again at every active-set refresh)
+        reach, near = model.dynamics.watched_limit(model, initial_state(model))
+        if model.dt <= reach:
+            logging.getLogger("meshwear").warning(
+                "%s: run.dt: %r s%s is above the stability limit of every vertex of the "
+                "riders pressing at once (%.6g s) and within that of the vertices within reach "
+                "of a surface at the start (%.6g s, body %r): the run checks it at every "
+                "active-set refresh and stops (exit 3) if the contact outgrows it",
+                model.scene.source, asked, rounded, limit, reach, near)
+            return reach
         raise SceneError(model.scene.source, "run.dt",
                          f"{asked!r} s{rounded} is above the stability limit of the contact "
-                         f"on body {who!r}; the largest stable dt is {limit:.6g} s")
-    return limit
+                         f"on body {near!r}; the largest stable dt is {limit:.6g} s with every "
+                         f"vertex pressing at once, {reach:.6g} s with the vertices within "
+                         "reach of a surface at the start")
+    raise SceneError(model.scene.source, "run.dt",
+                     f"{asked!r} s{rounded} is above the stability limit of the contact "
+                     f"on body {who!r}; the largest stable dt is {limit:.6g} s")
 
 

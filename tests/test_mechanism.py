@@ -14,7 +14,7 @@ import cases
 from meshwear import checkpoint
 from meshwear.cli import main
 from meshwear.mechanism import slot_wrench
-from meshwear.model import build_model, initial_state
+from meshwear.model import build_model, check_time_step, initial_state
 from meshwear.output.memory import MemoryHistory
 from meshwear.scene import SceneError, load_scene
 from meshwear.simulate import run
@@ -287,3 +287,81 @@ def test_the_compiled_mechanism_loop_matches_the_python_steps_to_the_last_bit():
             assert np.array_equal(getattr(a, name), getattr(b, name)), name
     assert np.array_equal(fast.parts[0].depth, slow.parts[0].depth)
     assert np.array_equal(mujoco_fast, model.mechanism.get_state())
+
+
+@pytest.mark.parametrize("speed, keeps", [(0.3, True), (10.0, False)])
+def test_active_sets_are_given_up_only_where_refreshes_come_faster_than_they_pay(
+        monkeypatch, speed, keeps):
+    """A disc turning slowly under the pin needs a refresh now and then, more
+    of them over the run than one trial window allows: the pin keeps its
+    active set. Turning fast, the disc's rim crosses the margin every few
+    steps: every vertex is checked."""
+    from meshwear.mechanism import TRIAL_REFRESHES, TRIAL_STEPS, Mechanism
+
+    count = []
+    refreshed = Mechanism.refreshed
+    monkeypatch.setattr(Mechanism, "refreshed",
+                        lambda self, b, s: (count.append(1), refreshed(self, b, s)))
+    scene = load_scene(PIN_ON_DISC, SHORT + [("run.duration", 1.0),
+                                             ("mechanism.controls.drive", speed)])
+    model = build_model(scene)
+    state = run(model, initial_state(model))
+    assert model.cull is keeps
+    if keeps:
+        assert len(count) > TRIAL_REFRESHES          # more than one window's worth in all
+        assert len(state.bodies[0].active) < len(state.bodies[0].vertices)
+        assert len(count) * TRIAL_STEPS < TRIAL_REFRESHES * model.n_steps
+    else:
+        assert len(state.bodies[0].active) == len(state.bodies[0].vertices)
+
+
+def test_a_step_above_the_every_vertex_bound_runs_while_the_vertices_within_reach_allow_it(
+        caplog):
+    """The pin's 34 vertices within reach of the disc allow 3.8x the step of
+    its 1488 pressing at once: run.dt between the two is taken (a warning
+    says so), checked at every refresh, and the pin still wears k P s."""
+    scene = load_scene(PIN_ON_DISC, SHORT + [("mechanism.controls.drive", 0.3),
+                                             ("run.dt", 1e-4)])
+    model = build_model(scene)
+    assert model.mechanism.strict < model.dt
+    with caplog.at_level("WARNING", logger="meshwear"):
+        assert check_time_step(model) >= model.dt
+    assert "run.dt" in caplog.text and "at every active-set refresh" in caplog.text
+    model, state, rows = _run(scene)
+    assert model.cull and model.mechanism.failed is None
+    pin = rows["pin"]
+    turned = pin["spin.q"][-1] - pin["spin.q"][0]
+    load = PRESS + MASS * G
+    assert pin["wear_volume"][-1] == pytest.approx(K * load * RADIUS * turned, rel=5e-3)
+
+
+def test_a_step_above_what_the_vertices_within_reach_allow_is_refused_naming_both_limits(
+        capsys):
+    code = main(["check", str(PIN_ON_DISC), "--set", "run.dt=5e-4",
+                 "--set", "body[0].resolution=2e-3"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1
+    assert "run.dt" in err[0] and "every vertex pressing at once" in err[0]
+    assert "within reach of a surface at the start" in err[0]
+
+
+@pytest.mark.parametrize("drive", [None, 10.0])
+def test_a_step_the_contact_outgrows_stops_the_run_with_exit_3(tmp_path, capsys, drive):
+    """A cube thrown from 1 mm above the plate has no vertex within reach at
+    the start, so any step passes the start's check; when it comes down its
+    face does, and a step 6x the every-vertex bound stops the run there. A
+    pin on a disc turning fast gives its active sets up: every vertex may
+    then press, and the step above their bound is refused at once."""
+    if drive is None:
+        scene = _toss_scenes(tmp_path)[1]
+        extra = ["--set", "run.dt=1e-4", "--set", "run.duration=0.3"]
+        expected = "over its vertices within reach of a surface now"
+    else:
+        scene = PIN_ON_DISC
+        extra = ["--set", "run.dt=1e-4", "--set", "body[0].resolution=2e-3",
+                 "--set", f"mechanism.controls.drive={drive}", "--set", "run.duration=0.05"]
+        expected = "gave them up"
+    code = main(["run", str(scene), "-o", str(tmp_path / "out"), "-q", *extra])
+    err = capsys.readouterr().err
+    assert code == 3, err
+    assert "run.dt" in err and expected in err
