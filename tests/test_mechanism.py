@@ -365,3 +365,46 @@ def test_a_step_the_contact_outgrows_stops_the_run_with_exit_3(tmp_path, capsys,
     err = capsys.readouterr().err
     assert code == 3, err
     assert "run.dt" in err and expected in err
+
+
+def test_gears_under_torque_touch_on_their_drive_flanks_only_and_share_the_load():
+    """examples/mechanisms/gear_pair_torque.toml, 0.02 s: after the start
+    the pinion's trailing flanks carry nothing, one or two of its teeth
+    carry the load, and over two whole mesh periods the contact's moment on
+    the wheel balances the resisting torque (the wheel's speed back where it
+    was, within its ring)."""
+    scene = load_scene(cases.EXAMPLES / "mechanisms" / "gear_pair_torque.toml",
+                       [("run.duration", 0.02), ("run.frames", 0), ("run.history", 801),
+                        ("wear.acceleration", "none")])
+    model = build_model(scene)
+    vertices = model.bodies[0].reference_vertices - model.bodies[0].origin
+    phi = np.arctan2(vertices[:, 1], vertices[:, 0])
+    pitch = 2.0 * np.pi / 20
+    tooth = np.round(phi / pitch).astype(int)
+    leading = phi > tooth * pitch
+    wheel = model.mechanism.ids["wheel"]
+    samples = []
+
+    class Teeth:
+        def on_sample(self, model, state):
+            force = state.bodies[0].normal_force.sum(axis=0)
+            samples.append((state.time, np.bincount(tooth[leading] % 20, force[leading],
+                                                    minlength=20),
+                            force[~leading].sum(), model.mechanism.data.xfrc_applied[wheel, 5]))
+
+        def on_frame(self, model, state):
+            pass
+
+    run(model, initial_state(model), observers=[Teeth()])
+    window = [s for s in samples if s[0] >= 0.02 - 2 * pitch / 100.0 - 1e-12]
+    per_tooth = np.array([s[1] for s in window])
+    total = per_tooth.sum(axis=1)
+    assert max(s[2] for s in window) == 0.0                     # single-flank contact
+    pairs = (per_tooth > 0.02 * total.mean()).sum(axis=1)
+    assert set(pairs) == {1, 2}
+    torque = dict(zip(*[[model.mechanism.model.actuator(a).name for a in range(2)],
+                       model.mechanism.data.ctrl]))["load"]
+    # (measured 9e-4: the wheel's ring, not quite whole periods of it)
+    assert np.mean([s[3] for s in window]) == pytest.approx(-torque, rel=0.01)
+    # the torque over the base radius; friction (0.1) moves it by 1.3 %
+    assert total.mean() == pytest.approx(torque / (0.02 * np.cos(np.radians(20.0))), rel=0.03)
