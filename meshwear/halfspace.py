@@ -1,0 +1,218 @@
+"""Elastic half-space contact on a regular grid (docs/model.md, "Elastic half-space").
+
+Two elastic bodies whose contact patch is small against their radii of
+curvature touch as two half-spaces do: the normal displacement of the
+surfaces is the pressure convolved with Boussinesq's influence function, the
+tangential one the shear convolved with Cerruti's. On a regular grid of
+cells (uniform traction over each), the influence coefficients are Love's
+closed forms for a rectangle, the convolution is a discrete convolution that
+the FFT evaluates without wrap-around error on a grid padded to twice the
+size (DC-FFT: Liu, Wang and Liu, Wear 243 (2000) 101-111), and the contact
+conditions are solved by the constrained conjugate gradient of Polonsky and
+Keer (Wear 231 (1999) 206-219): pressure ``p >= 0``, gap ``g >= 0``,
+``p g = 0`` and the total load given.
+
+Normal and tangential problems are uncoupled (Goodman's approximation:
+exact for bodies of the same material, ``(1 - 2 nu) / G`` equal; otherwise
+it neglects the normal displacement that shear causes). The tangential
+problem of a contact loaded along x (Cattaneo-Mindlin) is the normal one in
+disguise: with the stick reserve ``w = mu p - q`` (``q`` the shear along the
+slip), the stick zone is where ``w > 0`` and the surfaces move as one, the
+slip zone where ``w = 0``; ``w`` is found by the same solver with Cerruti's
+kernel, on the contact cells only, its total ``mu P - Q``
+(:func:`solve_shear`).
+
+Every function works on 1-D grids (plane strain: a line contact, per unit
+length) and 2-D grids (a patch) alike; lengths in m, pressures in Pa.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import fft
+
+
+def contact_modulus(youngs, poisson):
+    """The contact modulus ``E*`` (Pa) of two bodies:
+    ``1 / E* = (1 - nu1^2) / E1 + (1 - nu2^2) / E2``."""
+    return 1.0 / sum((1.0 - nu * nu) / e for e, nu in zip(youngs, poisson))
+
+
+def _love(x, y, shear_nu=None):
+    """Antiderivative of ``1 / r`` (``shear_nu`` None) or of Cerruti's
+    ``(1 - nu) / r + nu x^2 / r^3`` over x and y, at (x, y)."""
+    r = np.hypot(x, y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = np.where(x == 0.0, 0.0, x * np.log(np.where(y + r > 0.0, y + r, 1.0)))
+        b = np.where(y == 0.0, 0.0, y * np.log(np.where(x + r > 0.0, x + r, 1.0)))
+    return a + b if shear_nu is None else (1.0 - shear_nu) * a + b
+
+
+def _cell_integral(x, y, hx, hy, shear_nu=None):
+    """Integral over the cell ``[-hx, hx] x [-hy, hy]`` of the kernel seen
+    from (x, y)."""
+    return (_love(x + hx, y + hy, shear_nu) - _love(x - hx, y + hy, shear_nu)
+            - _love(x + hx, y - hy, shear_nu) + _love(x - hx, y - hy, shear_nu))
+
+
+def _strip_integral(x, hx):
+    """Integral of ``-ln |s|`` over ``s`` in ``[x - hx, x + hx]`` (the
+    plane-strain line load's displacement, up to a constant)."""
+    def f(s):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(s == 0.0, 0.0, s * np.log(np.abs(s))) - s
+    return -(f(x + hx) - f(x - hx))
+
+
+@dataclass
+class Grid:
+    """A regular grid of ``shape`` cells of ``spacing`` (m) centred on the
+    origin (1-D or 2-D), and the Fourier transforms of its influence
+    kernels on the padded grid (DC-FFT)."""
+
+    shape: tuple
+    spacing: tuple
+    normal: np.ndarray           # rfftn of the normal kernel (m/Pa)
+    shear: np.ndarray            # rfftn of the tangential (x) kernel (m/Pa), or None
+
+    @property
+    def cell_area(self):
+        """Area of a cell (m^2; per unit length in 1-D: its width, m)."""
+        return float(np.prod(self.spacing))
+
+    @property
+    def centres(self):
+        """Coordinates of the cell centres along each axis (m)."""
+        return [h * (np.arange(n) - 0.5 * (n - 1)) for n, h in zip(self.shape, self.spacing)]
+
+    def convolve(self, traction, kernel="normal"):
+        """The displacement (m) the ``traction`` (Pa) on the cells causes at
+        each cell's centre, by the ``normal`` (Boussinesq) or ``shear``
+        (Cerruti, along x) kernel."""
+        padded = tuple(2 * n for n in self.shape)
+        k = self.normal if kernel == "normal" else self.shear
+        out = fft.irfftn(k * fft.rfftn(traction, padded), padded)
+        return out[tuple(slice(0, n) for n in self.shape)]
+
+
+def make_grid(shape, spacing, youngs, poisson):
+    """A :class:`Grid` of ``shape`` cells (1-D: plane strain, or 2-D) of
+    ``spacing`` (m) for two bodies of Young's moduli ``youngs`` (Pa) and
+    Poisson's ratios ``poisson`` (pairs)."""
+    shape = tuple(int(n) for n in np.atleast_1d(shape))
+    spacing = tuple(float(h) for h in np.broadcast_to(spacing, (len(shape),)))
+    # the kernel on the padded grid in wrap-around order: offsets 0 .. n-1,
+    # then -n .. -1 (offset n multiplies the padding only)
+    offsets = []
+    for n, h in zip(shape, spacing):
+        i = np.arange(2 * n)
+        d = np.where(i < n, i, i - 2 * n).astype(float) * h
+        offsets.append(d)
+    normal_compliance = sum((1.0 - nu * nu) / e for e, nu in zip(youngs, poisson))
+    if len(shape) == 1:
+        # plane strain: u = -(2 / (pi E*)) integral p ln|x - s| ds + const
+        k = 2.0 * normal_compliance / np.pi * _strip_integral(offsets[0], 0.5 * spacing[0])
+        return Grid(shape, spacing, fft.rfftn(k), None)
+    x, y = np.meshgrid(offsets[0], offsets[1], indexing="ij")
+    hx, hy = 0.5 * spacing[0], 0.5 * spacing[1]
+    k = normal_compliance / np.pi * _cell_integral(x, y, hx, hy)
+    shear = sum(1.0 / (2.0 * np.pi * e / (2.0 * (1.0 + nu)))
+                * _cell_integral(x, y, hx, hy, shear_nu=nu) for e, nu in zip(youngs, poisson))
+    return Grid(shape, spacing, fft.rfftn(k), fft.rfftn(shear))
+
+
+@dataclass
+class Solution:
+    """A solved contact: ``traction`` (Pa) on the cells, the rigid approach
+    (m; the load-controlled problem's Lagrange multiplier), the cells'
+    ``gap`` (m, zero where they touch), the iterations taken and the
+    residual reached."""
+
+    traction: np.ndarray
+    approach: float
+    gap: np.ndarray
+    iterations: int
+    residual: float
+
+
+def solve(grid, gap, load, mask=None, kernel="normal", start=None, tol=1e-10,
+          max_iterations=2000):
+    """The traction ``p >= 0`` of total ``load`` (N; N/m in 1-D) on the
+    cells with ``grid``'s ``kernel``, under the initial ``gap`` (m) of the
+    surfaces before any approach: ``gap + u(p) - approach >= 0``, zero
+    where ``p > 0`` (Polonsky and Keer's constrained conjugate gradient).
+    ``mask`` (bool): the cells that may carry traction (default all);
+    ``start``: a traction to start from (a warm start: the last step's).
+    """
+    h = np.asarray(gap, float)
+    allowed = np.ones(h.shape, bool) if mask is None else np.asarray(mask, bool)
+    area = grid.cell_area
+    if load <= 0.0 or not allowed.any():
+        return Solution(np.zeros_like(h), float(h[allowed].min()) if allowed.any() else 0.0,
+                        h.copy(), 0, 0.0)
+    if start is not None and np.any(start[allowed] > 0.0):
+        p = np.where(allowed, np.maximum(start, 0.0), 0.0)
+    else:
+        p = allowed.astype(float)         # uniform, as Polonsky and Keer start
+    p *= load / (p.sum() * area)
+    t = np.zeros_like(h)
+    g_old, conjugate = 1.0, False
+    residual = np.inf
+    for iteration in range(1, max_iterations + 1):
+        g = grid.convolve(p, kernel) + h
+        touching = p > 0.0
+        mean = g[touching].mean()
+        g -= mean
+        G = float(g[touching] @ g[touching])
+        t = np.where(touching, g + (G / g_old if conjugate else 0.0) * t, 0.0)
+        g_old = G
+        r = grid.convolve(t, kernel)
+        r -= r[touching].mean()
+        denominator = float(r[touching] @ t[touching])
+        tau = float(g[touching] @ t[touching]) / denominator if denominator != 0.0 else 0.0
+        previous = p
+        p = p - tau * t
+        p = np.where(allowed, np.maximum(p, 0.0), 0.0)
+        overlap = allowed & (p == 0.0) & (g < 0.0)
+        conjugate = not overlap.any()
+        p = np.where(overlap, p - tau * g, p)
+        p *= load / (p.sum() * area)
+        residual = float(np.abs(p - previous).sum() * area / load)
+        if residual < tol:
+            break
+    g = grid.convolve(p, kernel) + h
+    touching = p > 0.0
+    approach = float(g[touching].mean())
+    return Solution(p, approach, np.where(allowed, g - approach, np.inf), iteration, residual)
+
+
+def solve_shear(grid, pressure, friction, force, previous=None, previous_force=0.0,
+                previous_shift=0.0, tol=1e-10):
+    """Cattaneo-Mindlin partial slip along x under the ``pressure`` (Pa)
+    solved before: the shear ``q`` (Pa) on the cells at tangential ``force``
+    (N), reached monotonically from the shear ``previous`` at
+    ``previous_force`` and tangential shift ``previous_shift`` (default:
+    none, at 0; a load reversed is a new segment from where it turned:
+    Mindlin and Deresiewicz). Returns ``q``, the stick cells (bool) and the
+    tangential shift (m) of the bodies, the displacement of the points far
+    from the contact relative to each other (NaN in gross slip).
+
+    In a segment of direction ``s = sign(force - previous_force)`` the slip
+    cells carry ``s mu p`` and the stick cells move on together by the
+    shift's increment ``d``, so the stick reserve ``w = mu p - s q >= 0``
+    solves :func:`solve` with Cerruti's kernel on the contact: its "gap"
+    ``-mu u_x(p) + s u_x(q0)`` (``q0`` = ``previous``), its total
+    ``mu P - s Q``, its approach ``-s d``."""
+    contact = pressure > 0.0
+    limit = friction * pressure
+    q0 = np.zeros_like(limit) if previous is None else np.asarray(previous, float)
+    if force == previous_force:
+        return q0.copy(), contact & (np.abs(q0) < limit * (1.0 - 1e-9)), previous_shift
+    sign = 1.0 if force > previous_force else -1.0
+    reserve_load = float(limit.sum() * grid.cell_area) - sign * force
+    if reserve_load <= 0.0:
+        return sign * limit, np.zeros(pressure.shape, bool), float("nan")
+    gap = -grid.convolve(limit, "shear") + sign * grid.convolve(q0, "shear")
+    reserve = solve(grid, gap, reserve_load, mask=contact, kernel="shear", tol=tol)
+    q = sign * (limit - reserve.traction)
+    return q, reserve.traction > 0.0, previous_shift - sign * reserve.approach
