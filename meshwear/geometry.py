@@ -97,9 +97,14 @@ def load_mesh(path, units="m"):
     return clean(vertices * scale, faces, source=str(path))
 
 
-def load_part(config):
+def load_part(config, mechanism=None):
     """The mesh of a body or mesh surface config: its ``mesh`` file (in its
-    ``units``) or its ``shape`` primitive; (vertices, faces)."""
+    ``units``), its ``shape`` primitive, or the mesh geom of the
+    ``mechanism`` it names (``mechanism_geom``, in its body's frame);
+    (vertices, faces)."""
+    if getattr(config, "mechanism_geom", None) is not None:
+        vertices, faces = mechanism.geom_mesh(config.mechanism_geom, config.mechanism_body)
+        return clean(vertices, faces, source=f"geom {config.mechanism_geom!r}")
     if config.mesh is not None:
         return load_mesh(config.mesh, config.units)
     s = config.shape

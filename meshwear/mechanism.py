@@ -112,6 +112,9 @@ class Mechanism:
             raise SceneError(scene.source, "mechanism.model",
                              f"{path.name}: the RK4 integrator cannot take meshwear's contact "
                              "forces within its step; use Euler, implicit or implicitfast")
+        for key, x in riders:
+            if getattr(x, "mechanism_geom", None) is not None:
+                self._check_geom(scene, key, x.mechanism_geom, x.mechanism_body, path)
         #: the timestep of the MJCF file (s), before meshwear sets its own
         self.file_timestep = float(m.opt.timestep)
         config = scene.mechanism
@@ -149,6 +152,33 @@ class Mechanism:
         self.strict, self.failed, self.due = np.inf, None, False
 
     # ------------------------------------------------------------ set-up
+    def _check_geom(self, scene, key, name, body, path):
+        """A part's ``mechanism_geom``: a mesh geom of its mechanism body."""
+        m, mujoco = self.model, self.mujoco
+        mesh = int(mujoco.mjtGeom.mjGEOM_MESH)
+        own = [m.geom(g).name for g in range(m.ngeom)
+               if m.body(int(m.geom_bodyid[g])).name == body and int(m.geom_type[g]) == mesh]
+        if name not in own:
+            raise SceneError(scene.source, f"{key}.mechanism_geom",
+                             f"{name!r} is not a mesh geom of body {body!r} in {path.name} "
+                             f"(its mesh geoms: {', '.join(map(repr, own)) or 'none'})")
+
+    def geom_mesh(self, name, body):
+        """(vertices, faces) of mesh geom ``name`` in the frame of its body
+        ``body``: MuJoCo's vertices (scaled, re-centred on the mesh's
+        centroid and turned to its principal axes when it compiled them)
+        placed by the geom's ``pos`` and ``quat``, which undo that, so the
+        part lies where the MJCF file puts the mesh."""
+        m = self.model
+        g = m.geom(name).id
+        mesh = int(m.geom_dataid[g])
+        start, count = int(m.mesh_vertadr[mesh]), int(m.mesh_vertnum[mesh])
+        vertices = np.asarray(m.mesh_vert[start:start + count], dtype=np.float64)
+        first, faces = int(m.mesh_faceadr[mesh]), int(m.mesh_facenum[mesh])
+        faces = np.asarray(m.mesh_face[first:first + faces], dtype=np.int64)
+        rotation = quaternion_matrix(np.asarray(m.geom_quat[g], dtype=np.float64))
+        return vertices @ rotation.T + np.asarray(m.geom_pos[g], dtype=np.float64), faces
+
     def finish(self):
         """After the model is built: the riders' motions become rows of one
         array the compiled loop writes (each surface's arrays views of it),

@@ -274,10 +274,9 @@ def build_model(scene):
     built = []
     for j, s in enumerate(scene.surfaces):
         try:
-            built.append(surfaces.build_surface(s))
+            built.append(surfaces.build_surface(s, mechanism))
         except geometry.MeshError as err:
-            key = f"surface[{j}].mesh" if s.mesh is not None else f"surface[{j}].shape"
-            raise SceneError(scene.source, key, str(err)) from None
+            raise SceneError(scene.source, _part_key(f"surface[{j}]", s), str(err)) from None
     # the bodies are refined where they face the surfaces, then the mesh
     # surfaces where the bodies can reach them over the run
     if mechanism is not None:
@@ -291,8 +290,7 @@ def build_model(scene):
             try:
                 built[j] = surface.refined(s, _surface_faces_to_refine(scene, surface, bodies))
             except geometry.MeshError as err:
-                key = f"surface[{j}].mesh" if s.mesh is not None else f"surface[{j}].shape"
-                raise SceneError(scene.source, key, str(err)) from None
+                raise SceneError(scene.source, _part_key(f"surface[{j}]", s), str(err)) from None
     for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
         if getattr(s, "wear", False):
             if scene.wear.acceleration == "cycle_jump" and scene.wear.jump == "explicit":
@@ -375,6 +373,14 @@ def build_model(scene):
                  cycle_steps=cycle_steps, mechanism=mechanism)
 
 
+def _part_key(prefix, config):
+    """The key of a part's mesh: ``mesh``, ``shape`` or ``mechanism_geom``."""
+    for key in ("mechanism_geom", "mesh"):
+        if getattr(config, key, None) is not None:
+            return f"{prefix}.{key}"
+    return f"{prefix}.shape"
+
+
 def _ride(mechanism, surface, index, name, t):
     """Put counter-surface ``surface`` on mechanism body ``name``: its rest
     frame becomes its placement in that body's frame, its motion a steady
@@ -401,8 +407,7 @@ def _build_bodies(scene, surface_set, mechanism=None):
             bodies.append(_build_body(scene, j, b, surface_set, mechanism))
         except geometry.MeshError as err:
             # the mesh loader names the mesh file; add the scene file and the key
-            key = f"body[{j}].mesh" if b.mesh is not None else f"body[{j}].shape"
-            raise SceneError(scene.source, key, str(err)) from None
+            raise SceneError(scene.source, _part_key(f"body[{j}]", b), str(err)) from None
     return tuple(bodies)
 
 
@@ -544,7 +549,7 @@ def _even_steps(n_steps, count):
 
 def _build_body(scene, index, body, surface_set, mechanism=None):
     key = f"body[{index}]"
-    vertices, faces = geometry.load_part(body)
+    vertices, faces = geometry.load_part(body, mechanism)
     refinement = None
     if body.resolution is not None:
         vertices, faces, refinement = remesh.refine_part(
@@ -555,7 +560,8 @@ def _build_body(scene, index, body, surface_set, mechanism=None):
     try:
         mass, com, inertia = geometry.mass_properties(
             vertices, faces, density=body.density, mass=body.mass,
-            source=str(body.mesh) if body.mesh is not None else f"{key}.shape")
+            source=(str(body.mesh) if body.mesh is not None
+                    else _part_key(key, body)))
         if riding:
             # MuJoCo's mass, the mesh's distribution of it (the stability limit)
             scale = mechanism.mass(body.mechanism_body) / mass

@@ -49,7 +49,8 @@ SHAPE_REQUIRED = {"box": ("size",), "sphere": ("radius",), "cylinder": ("radius"
 SURFACE_KEYS = {
     "plane": ("point", "normal", "size", "rotation", "path", "mechanism_body"),
     "mesh": ("mesh", "shape", "units", "resolution", "position", "orientation", "rotation",
-             "path", "smooth_normals", "wear", "law", "coefficient", "mechanism_body"),
+             "path", "smooth_normals", "wear", "law", "coefficient", "mechanism_body",
+             "mechanism_geom"),
     "cylinder": ("radius", "axis", "point", "length", "side", "rotation", "path",
                  "mechanism_body"),
     "sphere": ("radius", "center", "side", "rotation", "path", "mechanism_body"),
@@ -67,11 +68,32 @@ PARALLEL = 1e-9
 
 
 def _check_mesh_or_shape(obj):
-    """Shared by bodies and mesh surfaces: exactly one of mesh/shape, units."""
+    """Shared by bodies and mesh surfaces: exactly one of mesh/shape (or, on
+    a mechanism body, mechanism_geom), units."""
     if obj.mesh is not None and obj.shape is not None:
         raise SceneError("", "shape", "give either mesh or shape, not both")
+    if obj.mechanism_geom is not None:
+        if obj.mesh is not None or obj.shape is not None:
+            raise SceneError("", "mechanism_geom", "the part's mesh is that geom's; leave "
+                             + ("mesh" if obj.mesh is not None else "shape") + " out")
+        if not isinstance(obj.mechanism_geom, str) or not obj.mechanism_geom:
+            raise SceneError("", "mechanism_geom", "expected the name of a mesh geom of the "
+                             f"[mechanism] model, got {_show(obj.mechanism_geom)}")
+        if obj.mechanism_body is None:
+            raise SceneError("", "mechanism_geom", "takes the mesh of a geom of the "
+                             "[mechanism] model: name the body it is on (mechanism_body) too")
+        for key, default in (("units", "m"), ("position", (0.0, 0.0, 0.0)),
+                             ("orientation", (1.0, 0.0, 0.0, 0.0))):
+            if getattr(obj, key) != default and list(getattr(obj, key)) != list(default):
+                raise SceneError("", key, f"does not apply to the mesh of geom "
+                                 f"{obj.mechanism_geom!r}: the MJCF file places and scales it")
+        _set_optional(obj, "resolution", _length)
+        _set_optional(obj, "path", _instance, PathConfig)
+        return
     if obj.mesh is None and obj.shape is None:
-        raise SceneError("", "mesh", 'missing; give mesh = "file.stl" or shape = { type = ... }')
+        raise SceneError("", "mesh", 'missing; give mesh = "file.stl" or shape = { type = ... }'
+                         + ('' if obj.mechanism_body is None else
+                            ' or mechanism_geom = "a mesh geom of the [mechanism] model"'))
     if obj.mesh is not None:
         if not isinstance(obj.mesh, (str, os.PathLike)):
             raise SceneError("", "mesh", f"expected a file name, got {_show(obj.mesh)}")
@@ -378,7 +400,8 @@ class BodyConfig:
     ``mechanism_body`` names the body of the ``[mechanism]`` model the part
     rides on (its motion is then ``"mechanism"``, from MuJoCo, with MuJoCo's
     mass); ``position`` and ``orientation`` then place the mesh in that
-    body's frame.
+    body's frame. ``mechanism_geom`` (instead of mesh and shape) takes the
+    mesh of a mesh geom of that body, placed as MuJoCo places it.
     """
 
     name: str
@@ -396,6 +419,7 @@ class BodyConfig:
     motion: str = "free"
     path: PathConfig | None = None
     mechanism_body: str | None = None
+    mechanism_geom: str | None = None
 
     def __post_init__(self):
         _set(self, "name", _name)
@@ -494,8 +518,10 @@ class SurfaceConfig:
     wear: bool = False
     law: str | None = None
     coefficient: float | str | None = None
-    #: the [mechanism] body it rides on (its motion then comes from MuJoCo)
+    #: the [mechanism] body it rides on (its motion then comes from MuJoCo),
+    #: and the mesh geom of that body that is its mesh (instead of mesh/shape)
     mechanism_body: str | None = None
+    mechanism_geom: str | None = None
 
     def __post_init__(self):
         _set(self, "name", _name)

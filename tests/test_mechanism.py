@@ -408,3 +408,62 @@ def test_gears_under_torque_touch_on_their_drive_flanks_only_and_share_the_load(
     assert np.mean([s[3] for s in window]) == pytest.approx(-torque, rel=0.01)
     # the torque over the base radius; friction (0.1) moves it by 1.3 %
     assert total.mean() == pytest.approx(torque / (0.02 * np.cos(np.radians(20.0))), rel=0.03)
+
+
+def _geom_pin(tmp_path):
+    """pin_on_disc with the pin's mesh from an MJCF mesh geom: the example's
+    cylinder written to an STL off its centre (MuJoCo re-centres it on its
+    centroid) and placed back by the geom's pos and a quarter turn."""
+    import trimesh
+
+    from meshwear.geometry import primitive
+
+    vertices, faces = primitive("cylinder", radius=0.002, height=0.006, sections=32)
+    turn = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])   # -90° about z
+    trimesh.Trimesh(vertices @ turn.T + [0.0005, 0.0, 0.0], faces,
+                    process=False).export(tmp_path / "pin.stl")
+    xml = (PIN_ON_DISC.parent / "pin_on_disc.xml").read_text()
+    xml = xml.replace('<geom type="cylinder" size="0.002 0.003" mass="0.2"/>',
+                      '<geom name="pin_mesh" type="mesh" mesh="pin" mass="0.2" '
+                      'pos="0 -0.0005 0" quat="0.7071067811865476 0 0 0.7071067811865476"/>')
+    xml = xml.replace("<worldbody>", '<asset><mesh name="pin" file="pin.stl"/></asset>\n'
+                      "  <worldbody>")
+    (tmp_path / "pin_on_disc.xml").write_text(xml)
+    scene = PIN_ON_DISC.read_text().replace(
+        'shape = { type = "cylinder", radius = 0.002, height = 0.006, sections = 32 }\n'
+        "resolution = 1e-3", 'mechanism_geom = "pin_mesh"')
+    (tmp_path / "scene.toml").write_text(scene)
+    return tmp_path / "scene.toml"
+
+
+def test_a_part_takes_its_mesh_from_a_mesh_geom_where_mujoco_places_it(tmp_path):
+    from meshwear.surfaces import quaternion_matrix
+
+    short = [("run.duration", 0.05), ("run.frames", 0), ("run.history", 6)]
+    geom = build_model(load_scene(_geom_pin(tmp_path), short))
+    shape = build_model(load_scene(PIN_ON_DISC, short + [("body[0].resolution", None)]))
+    worlds = []
+    for model in (geom, shape):
+        b = model.bodies[0]
+        world = b.reference_vertices @ quaternion_matrix(b.initial_pose[3:7]).T + b.initial_pose[0:3]
+        worlds.append(world[np.lexsort(np.round(world, 9).T)])
+    assert worlds[0].shape == worlds[1].shape
+    assert np.abs(worlds[0] - worlds[1]).max() < 1e-9                 # float32 in MuJoCo
+    results = [run(model, initial_state(model)).bodies[0].wear_volume.sum()
+               for model in (geom, shape)]
+    assert results[0] == pytest.approx(results[1], rel=1e-4)
+
+
+@pytest.mark.parametrize("change, key, message", [
+    ('mechanism_geom = "pin_pad"', "mechanism_geom",
+     "'pin_pad' is not a mesh geom of body 'pin' in pin_on_disc.xml (its mesh geoms: 'pin_mesh')"),
+    ('mechanism_geom = "pin_mesh"\nunits = "mm"', "units", "the MJCF file places and scales it"),
+    ('mechanism_geom = "pin_mesh"\nmesh = "pin.stl"', "mechanism_geom", "leave mesh out"),
+])
+def test_a_bad_mechanism_geom_is_one_line_naming_the_key(tmp_path, capsys, change, key, message):
+    scene = _geom_pin(tmp_path)
+    scene.write_text(scene.read_text().replace('mechanism_geom = "pin_mesh"', change))
+    code = main(["check", str(scene)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert f"body[0].{key}" in err[0] and message in err[0]

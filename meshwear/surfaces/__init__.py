@@ -18,14 +18,17 @@ from .plane import Plane
 TYPES = {"plane": Plane, "cylinder": Cylinder, "sphere": Sphere, "mesh": MeshSurface}
 
 
-def build_surface(config):
-    """The counter-surface of a validated ``[[surface]]`` table.
+def build_surface(config, mechanism=None):
+    """The counter-surface of a validated ``[[surface]]`` table (a mesh one
+    may take its mesh from a geom of the ``mechanism``).
 
     Raises
     ------
     meshwear.geometry.MeshError
         For a mesh the engine cannot use; the caller adds the key.
     """
+    if config.type == "mesh":
+        return MeshSurface.from_config(config, mechanism)
     return TYPES[config.type].from_config(config)
 
 

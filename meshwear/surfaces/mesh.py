@@ -89,15 +89,16 @@ class MeshSurface(CounterSurface):
         self.bvh = fcl.CollisionObject(self.bvh_geometry, fcl.Transform())
 
     @classmethod
-    def from_config(cls, config):
-        """A :class:`MeshSurface` from a validated ``[[surface]]`` of type mesh.
+    def from_config(cls, config, mechanism=None):
+        """A :class:`MeshSurface` from a validated ``[[surface]]`` of type
+        mesh (its mesh from a geom of the ``mechanism`` if it names one).
 
         Raises
         ------
         geometry.MeshError
             For a mesh the engine cannot use; the caller adds the key.
         """
-        vertices, faces = geometry.load_part(config)
+        vertices, faces = geometry.load_part(config, mechanism)
         return cls(config.name, vertices, faces, config.position, config.orientation,
                    config.rotation, config.path, config.smooth_normals)
 
