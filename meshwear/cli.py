@@ -349,7 +349,9 @@ def _check(scene_path, overrides=()):
     e = estimate_run(model)
     full = "" if not model.cycle_steps else (
         "with cycle jumping " if e.trial_covered >= model.n_steps else
-        f"with cycle jumps growing as in a {e.trial_time:.2g} s trial ")
+        f"with cycle jumps growing as in a {e.trial_time:.2g} s trial " if e.trial_jumps else
+        f"with cycle jumps (none yet in a {e.trial_time:.2g} s trial of "
+        f"{e.trial_covered / model.cycle_steps:.2g} cycles: a rough guess) ")
     print(f"  estimated run time {full}{e.total:.3g} s: stepping {e.stepping:.3g} s "
           f"({e.per_step * 1e6:.3g} µs per step, {e.points / e.per_step:.3g} vertex-steps/s; "
           f"{e.active} of {e.vertices} vertices within reach of a surface), "

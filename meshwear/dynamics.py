@@ -38,6 +38,9 @@ The interface (a new engine is one more class):
     taken, watched at every refresh (inf: it takes none).
 ``instability(model, t, until=None)``
     The message of a step it found unstable.
+``warm_steps``
+    Steps ``meshwear check``'s estimate takes before it times steps (its
+    own start-up: a mechanism's trial of its active sets).
 """
 
 import numpy as np
@@ -50,6 +53,9 @@ class OwnMotions:
     """meshwear's own motions: every body moves by its :mod:`meshwear.motion`
     rule inside the compiled loop; bodies that share a worn counter-surface
     take their steps in turn, one each."""
+
+    #: steps a cost estimate takes before timing them (the compile)
+    warm_steps = 1
 
     def advance(self, model, state, until, step_bodies):
         if model.worn_counters and len(model.bodies) > 1:

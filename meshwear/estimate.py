@@ -22,6 +22,10 @@ TRIAL_STEPS, TRIAL_SECONDS = 200, 2.0
 #: JUMP_TRIAL_LONGEST, until bounds other than growth have set BOUNDED_JUMPS
 #: jumps (what the rest of the run's jumps are extrapolated from)
 JUMP_TRIAL, JUMP_TRIAL_LONGEST, BOUNDED_JUMPS = 3.0, 10.0, 8
+#: measurements the controller takes before its noise bounds let a first
+#: jump through (a vertex's scatter is fitted over three:
+#: :func:`meshwear.wear._counter_noise`)
+FIRST_JUMP_MEASUREMENTS = 3
 
 
 @dataclass
@@ -39,6 +43,7 @@ class Estimate:
     vertices: int
     trial_time: float = 0.0
     trial_covered: int = 0
+    trial_jumps: int = 0
 
     @property
     def total(self):
@@ -53,9 +58,12 @@ def estimate_run(model):
     """The :class:`Estimate` of ``model``'s run (a fresh state; nothing
     written but temporary files)."""
     state = initial_state(model)
-    warm = 1 if model.n_steps > 1 else 0
+    # compile (or load the cached) kernels, as the run does, and take the
+    # steps in which the dynamics try their active sets (a mechanism's first
+    # 200: refreshes every few steps where they do not pay), untimed per step
+    warm = min(model.n_steps - 1, model.dynamics.warm_steps) if model.n_steps > 1 else 0
     start = time.perf_counter()
-    stepper.advance(model, state, warm)  # compile (or load the cached) kernels, as the run does
+    stepper.advance(model, state, warm)
     load = time.perf_counter() - start
     trial = min(model.n_steps - warm, TRIAL_STEPS)
     done, chunk = 0, 1
@@ -75,7 +83,7 @@ def estimate_run(model):
                  per_step=per_step, points=active * max(1, model.slots), active=active,
                  vertices=vertices)
     if model.cycle_steps:
-        e.stepping, e.trial_time, e.trial_covered = _jumping(model, e.stepping)
+        e.stepping, e.trial_time, e.trial_covered, e.trial_jumps = _jumping(model, e.stepping)
         e.stepping += load
     return e
 
@@ -132,14 +140,17 @@ def _per_cycle(elapsed, js, step, n_c):
 
 
 def _jumping(model, resolved):
-    """``(seconds, trial seconds, steps covered by the trial)`` of a
-    cycle-jumping run: the run itself tried for :data:`JUMP_TRIAL` s (or to
-    its end; longer while it has seen fewer than :data:`BOUNDED_JUMPS` jumps
-    set by a bound other than growth), the rest simulated at the trial's
-    cost per resolved cycle with the controller's rule: jumps go on growing
-    (``GROWTH J + 1``) up to the trend of the other bounds in the trial
-    (:func:`_bound_trend`); and the remaining outputs filled from jumps at
-    the trial's cost per filled output (the writing itself is
+    """``(seconds, trial seconds, steps covered by the trial, jumps in the
+    trial)`` of a cycle-jumping run: the run itself tried for
+    :data:`JUMP_TRIAL` s (or to its end; longer while it has seen fewer than
+    :data:`BOUNDED_JUMPS` jumps set by a bound other than growth), the rest
+    simulated at the trial's cost per resolved cycle with the controller's
+    rule: the measurements it still needs before a first jump
+    (:data:`FIRST_JUMP_MEASUREMENTS`), then per jump a cycle to settle (the
+    dynamic mode) and a measurement of the trial's window of cycles, jumps
+    growing (``GROWTH J + 1``) up to the trend of the other bounds in the
+    trial (:func:`_bound_trend`); and the remaining outputs filled from jumps
+    at the trial's cost per filled output (the writing itself is
     :func:`_writing`'s). Never more than ``resolved``."""
     from .simulate import run
     from .wear import GROWTH
@@ -161,7 +172,7 @@ def _jumping(model, resolved):
         pass
     elapsed = time.perf_counter() - start
     if state.step >= model.n_steps:
-        return elapsed, elapsed, state.step
+        return elapsed, elapsed, state.step, state.jump.jumps if state.jump else 0
     n_c = model.cycle_steps
     js = state.jump
     # outputs inside a jump are filled from it: their cost beyond writing
@@ -173,14 +184,20 @@ def _jumping(model, resolved):
     position, total = state.step / n_c, model.n_steps / n_c
     bound = _bound_trend(js.taken)
     jump = float(js.last_jump)
+    window = float(js.window)
     seconds = elapsed + per_output * remaining
+    if js.jumps == 0:
+        # the measurements the noise bounds need before the first jump
+        waiting = max(0, FIRST_JUMP_MEASUREMENTS - len(js.history)) * window
+        position += waiting
+        seconds += waiting * per_cycle
     while position < total and seconds < resolved:
-        position += 1.0
-        seconds += per_cycle
+        position += window
+        seconds += window * per_cycle
         jump = GROWTH * jump + 1.0
         if bound is not None:
             jump = max(1.0, min(jump, bound[0] * position ** bound[1]))
         if position < total:
             position += jump + settle
             seconds += settle * per_cycle
-    return min(resolved, seconds), elapsed, state.step
+    return min(resolved, seconds), elapsed, state.step, js.jumps

@@ -146,6 +146,8 @@ class Mechanism:
         #: (part, state index, MuJoCo body id, placement) of the riders, set by the model
         self.bodies, self.surfaces = [], []
         self._wrench = np.zeros(6)
+        #: steps a cost estimate takes before timing steps: the active sets' trial
+        self.warm_steps = TRIAL_STEPS + 1
         #: the riders' stable step over every vertex (set by the model), the
         #: message of a run.dt above it that the active sets no longer hold
         #: (:meth:`watch`), and whether a refresh is to be checked
