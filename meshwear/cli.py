@@ -337,7 +337,8 @@ def _check(scene_path, overrides=()):
           f"{len(model.frame_steps)} frames, {len(model.sample_steps)} history rows")
     from .model import initial_state
 
-    for line in model.dynamics.describe(model, initial_state(model)):
+    state = initial_state(model)        # describe reads it, the estimate steps it
+    for line in model.dynamics.describe(model, state):
         print(f"  {line}")
     if model.cycle_steps:
         cycles = model.n_steps / model.cycle_steps
@@ -346,7 +347,7 @@ def _check(scene_path, overrides=()):
               "jumps are filled from them")
     from .estimate import estimate_run
 
-    e = estimate_run(model)
+    e = estimate_run(model, state)
     full = "" if not model.cycle_steps else (
         "with cycle jumping " if e.trial_covered >= model.n_steps else
         f"with cycle jumps growing as in a {e.trial_time:.2g} s trial " if e.trial_jumps else

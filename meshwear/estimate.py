@@ -54,10 +54,11 @@ class _Budget(Exception):
     pass
 
 
-def estimate_run(model):
-    """The :class:`Estimate` of ``model``'s run (a fresh state; nothing
-    written but temporary files)."""
-    state = initial_state(model)
+def estimate_run(model, state=None):
+    """The :class:`Estimate` of ``model``'s run from ``state``, a fresh one
+    (made here if None; it is stepped); nothing written but temporary
+    files."""
+    state = initial_state(model) if state is None else state
     # compile (or load the cached) kernels, as the run does, and take the
     # steps in which the dynamics try their active sets (a mechanism's first
     # 200: refreshes every few steps where they do not pay), untimed per step

@@ -84,7 +84,9 @@ def _check_mesh_or_shape(obj):
                              "[mechanism] model: name the body it is on (mechanism_body) too")
         for key, default in (("units", "m"), ("position", (0.0, 0.0, 0.0)),
                              ("orientation", (1.0, 0.0, 0.0, 0.0))):
-            if getattr(obj, key) != default and list(getattr(obj, key)) != list(default):
+            value = getattr(obj, key)
+            if value != default and not (isinstance(value, (list, tuple))
+                                         and tuple(value) == default):
                 raise SceneError("", key, f"does not apply to the mesh of geom "
                                  f"{obj.mechanism_geom!r}: the MJCF file places and scales it")
         _set_optional(obj, "resolution", _length)

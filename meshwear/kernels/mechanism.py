@@ -12,7 +12,7 @@ from numba import njit
 from .contact import FORCE, rotation_entries
 from .frames import moved_since_refresh, step_motion
 from .loop import DONE, REFRESH, advance_body
-from .rigid import STEADY
+from .rigid import STEADY, quaternion_product
 
 
 @njit(cache=True)
@@ -83,12 +83,9 @@ def place_body(xpos, xquat, xmat, cvel, subtree_com, rootid, body, placement, po
     pose[0] = xpos[body, 0] + ax
     pose[1] = xpos[body, 1] + ay
     pose[2] = xpos[body, 2] + az
-    w1, x1, y1, z1 = xquat[body, 0], xquat[body, 1], xquat[body, 2], xquat[body, 3]
-    w2, x2, y2, z2 = placement[3], placement[4], placement[5], placement[6]
-    qw = w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2
-    qx = w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2
-    qy = w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2
-    qz = w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2
+    qw, qx, qy, qz = quaternion_product(xquat[body, 0], xquat[body, 1], xquat[body, 2],
+                                        xquat[body, 3], placement[3], placement[4],
+                                        placement[5], placement[6])
     norm = np.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
     pose[3], pose[4], pose[5], pose[6] = qw / norm, qx / norm, qy / norm, qz / norm
     pose[7] = vx + wy * az - wz * ay

@@ -34,6 +34,15 @@ def _mul(m, x, y, z):
             m[2, 0] * x + m[2, 1] * y + m[2, 2] * z)
 
 
+@njit(cache=True, inline="always")
+def quaternion_product(w1, x1, y1, z1, w2, x2, y2, z2):
+    """The quaternion product (w1, x1, y1, z1) (w2, x2, y2, z2)."""
+    return (w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+            w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+            w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2)
+
+
 @njit(cache=True)
 def free_step(pose, wrench, inverse_mass, inertia_body, inverse_inertia_body,
               acceleration, dt):
@@ -80,11 +89,7 @@ def free_step(pose, wrench, inverse_mass, inertia_body, inverse_inertia_body,
         half = 0.5 * rate * dt
         sw = np.sin(half) / rate
         dw, dx, dy, dz = np.cos(half), sw * ox, sw * oy, sw * oz
-        w, x, y, z = pose[3], pose[4], pose[5], pose[6]
-        nw = dw * w - dx * x - dy * y - dz * z
-        nx = dw * x + dx * w + dy * z - dz * y
-        ny = dw * y - dx * z + dy * w + dz * x
-        nz = dw * z + dx * y - dy * x + dz * w
+        nw, nx, ny, nz = quaternion_product(dw, dx, dy, dz, pose[3], pose[4], pose[5], pose[6])
         norm = np.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
         pose[3], pose[4], pose[5], pose[6] = nw / norm, nx / norm, ny / norm, nz / norm
     # omega consistent with L at the new orientation
@@ -189,11 +194,8 @@ def turn(pose, params, axis, t):
     half = 0.5 * rate * t
     c, s = np.cos(half), np.sin(half)
     dw, dx, dy, dz = c, s * ax, s * ay, s * az
-    w, x, y, z = params[29], params[30], params[31], params[32]
-    pose[3] = dw * w - dx * x - dy * y - dz * z
-    pose[4] = dw * x + dx * w + dy * z - dz * y
-    pose[5] = dw * y - dx * z + dy * w + dz * x
-    pose[6] = dw * z + dx * y - dy * x + dz * w
+    pose[3], pose[4], pose[5], pose[6] = quaternion_product(dw, dx, dy, dz, params[29],
+                                                            params[30], params[31], params[32])
     ox, oy, oz = rate * ax, rate * ay, rate * az
     pose[10], pose[11], pose[12] = ox, oy, oz
     # the centre of mass about the turn's centre: r0 = start - centre, turned
