@@ -340,6 +340,14 @@ def _check(scene_path, overrides=()):
     state = initial_state(model)        # describe reads it, the estimate steps it
     for line in model.dynamics.describe(model, state):
         print(f"  {line}")
+    if model.elastic is not None:
+        from .elastic import describe
+
+        lines, warnings = describe(model, state)
+        for line in lines:
+            print(f"  {line}")
+        for line in warnings:
+            logging.getLogger("meshwear").warning("%s: %s", scene.source, line)
     if model.cycle_steps:
         cycles = model.n_steps / model.cycle_steps
         print(f"  cycle jumping: {model.cycle_steps} steps per cycle, {cycles:.6g} cycles, "

@@ -136,17 +136,23 @@ class Solution:
 
 
 def solve(grid, gap, load, mask=None, kernel="normal", start=None, tol=1e-10,
-          max_iterations=2000):
+          max_iterations=2000, approach=None):
     """The traction ``p >= 0`` of total ``load`` (N; N/m in 1-D) on the
     cells with ``grid``'s ``kernel``, under the initial ``gap`` (m) of the
     surfaces before any approach: ``gap + u(p) - approach >= 0``, zero
     where ``p > 0`` (Polonsky and Keer's constrained conjugate gradient).
     ``mask`` (bool): the cells that may carry traction (default all);
     ``start``: a traction to start from (a warm start: the last step's).
+    With ``approach`` (m) given instead of ``load`` (pass None), the
+    displacement-controlled problem: the traction the given approach
+    needs, its total whatever it comes to.
     """
     h = np.asarray(gap, float)
     allowed = np.ones(h.shape, bool) if mask is None else np.asarray(mask, bool)
     area = grid.cell_area
+    if approach is not None:
+        return _solve_approach(grid, h, float(approach), allowed, kernel, start, tol,
+                               max_iterations)
     if load <= 0.0 or not allowed.any():
         return Solution(np.zeros_like(h), float(h[allowed].min()) if allowed.any() else 0.0,
                         h.copy(), 0, 0.0)
@@ -184,6 +190,74 @@ def solve(grid, gap, load, mask=None, kernel="normal", start=None, tol=1e-10,
     touching = p > 0.0
     approach = float(g[touching].mean())
     return Solution(p, approach, np.where(allowed, g - approach, np.inf), iteration, residual)
+
+
+def _solve_approach(grid, h, approach, allowed, kernel, start, tol, max_iterations):
+    """:func:`solve` at a given ``approach``: the same conjugate gradient
+    without the load's constraint (no mean removed, no rescaling)."""
+    area = grid.cell_area
+    if start is not None and np.any(start[allowed] > 0.0):
+        p = np.where(allowed, np.maximum(start, 0.0), 0.0)
+    else:
+        # each cell's interference over its own influence coefficient
+        unit = np.zeros(h.shape)
+        unit[(0,) * h.ndim] = 1.0
+        own = float(grid.convolve(unit, kernel)[(0,) * h.ndim])
+        p = np.where(allowed, np.maximum(approach - h, 0.0) / own, 0.0)
+    if not p.any():
+        return Solution(p, approach, np.where(allowed, h - approach, np.inf), 0, 0.0)
+    t = np.zeros_like(h)
+    g_old, conjugate = 1.0, False
+    residual = np.inf
+    for iteration in range(1, max_iterations + 1):
+        g = grid.convolve(p, kernel) + h - approach
+        touching = p > 0.0
+        if not touching.any():
+            break
+        G = float(g[touching] @ g[touching])
+        t = np.where(touching, g + (G / g_old if conjugate else 0.0) * t, 0.0)
+        g_old = G
+        r = grid.convolve(t, kernel)
+        denominator = float(r[touching] @ t[touching])
+        tau = float(g[touching] @ t[touching]) / denominator if denominator != 0.0 else 0.0
+        previous = p
+        p = p - tau * t
+        p = np.where(allowed, np.maximum(p, 0.0), 0.0)
+        overlap = allowed & (p == 0.0) & (g < 0.0)
+        conjugate = not overlap.any()
+        p = np.where(overlap, p - tau * g, p)
+        total = float(p.sum())
+        residual = float(np.abs(p - previous).sum() / total) if total > 0.0 else 0.0
+        if residual < tol:
+            break
+    g = grid.convolve(p, kernel) + h - approach
+    return Solution(p, approach, np.where(allowed, g, np.inf), iteration, residual)
+
+
+def shear_at_shift(grid, pressure, friction, shift, turn=None, turn_shift=0.0, start=None,
+                   tol=1e-10):
+    """Cattaneo-Mindlin partial slip along x at a given tangential ``shift``
+    (m, the bodies' far points relative to each other; displacement control,
+    as a guided body's path imposes it), reached monotonically from the
+    shear ``turn`` at ``turn_shift`` (the segment's turning point: Mindlin
+    and Deresiewicz; default none, at 0). Returns the shear ``q`` (Pa), the
+    stick cells and the stick reserve ``w`` (a warm start for the next call
+    of the same segment: ``start``). The stick reserve
+    ``w = mu p - s q >= 0`` (``s`` the segment's direction) solves
+    :func:`solve` with Cerruti's kernel at the approach ``-s (shift -
+    turn_shift)`` (:func:`solve_shear` gives the force-controlled twin)."""
+    contact = pressure > 0.0
+    limit = friction * pressure
+    q0 = np.zeros_like(limit) if turn is None else np.asarray(turn, float)
+    change = shift - turn_shift
+    if change == 0.0:
+        return q0.copy(), contact & (np.abs(q0) < limit * (1.0 - 1e-9)), limit - np.abs(q0)
+    sign = 1.0 if change > 0.0 else -1.0
+    gap = -grid.convolve(limit, "shear") + sign * grid.convolve(q0, "shear")
+    reserve = solve(grid, gap, None, mask=contact, kernel="shear", start=start, tol=tol,
+                    approach=-sign * change)
+    w = np.minimum(reserve.traction, 2.0 * limit)
+    return sign * (limit - w), w > 0.0, w
 
 
 def solve_shear(grid, pressure, friction, force, previous=None, previous_force=0.0,

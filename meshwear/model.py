@@ -13,6 +13,8 @@ import numpy as np
 
 from . import geometry, remesh, surfaces
 from .dynamics import OwnMotions
+from .elastic import HalfSpace, PatchError
+from .elastic import step as elastic_step
 from .kernels.contact import LAW_SLOTS, all_vertices, contact, make_law, rotation_entries
 from .kernels.counter_wear import wear_counter
 from .kernels.laws import code_of
@@ -120,6 +122,9 @@ class Model:
     extent: float = 1.0
     #: the MuJoCo mechanism the riders move with (:mod:`meshwear.mechanism`), or None
     mechanism: object = None
+    #: the half-space contact's constants (:class:`meshwear.elastic.HalfSpace`),
+    #: or None: the Winkler foundation of ``law``
+    elastic: object = None
 
     @property
     def dynamics(self):
@@ -204,6 +209,9 @@ class BodyState:
     #: deepest vertex in contact has to be measured again against its
     #: ``depth_limit`` (docs/model.md, "Impacts"); 0: at the next step
     impact_room: np.ndarray = field(default_factory=lambda: np.zeros(1))
+    #: the half-space solve kept from step to step (:class:`meshwear.elastic.Patch`;
+    #: a cache, not saved in checkpoints), or None
+    elastic: object = None
 
 
 @dataclass(eq=False)
@@ -321,6 +329,17 @@ def build_model(scene):
     quasi_static = run.mode == "quasi-static"
     if quasi_static:  # no inertia, so no damping either
         law[[LAW_SLOTS.index(name) for name in LAW_SLOTS if "damping" in name]] = 0.0
+    elastic = None
+    if c.model == "half-space":
+        elastic = HalfSpace(c.youngs_modulus, c.poissons_ratio, c.friction)
+        # the Winkler foundation that stands in until the first solve (the
+        # start's placement): E* over a hundredth of the largest body
+        size = max(float(np.ptp(b.reference_vertices, axis=0).max()) for b in bodies)
+        law[LAW_SLOTS.index("stiffness")] = 0.0
+        law[LAW_SLOTS.index("stiffness_per_area")] = elastic.modulus / (0.01 * size)
+        law[LAW_SLOTS.index("tangential_stiffness")] = 0.0
+        law[LAW_SLOTS.index("tangential_stiffness_per_area")] = law[
+            LAW_SLOTS.index("stiffness_per_area")]
     for j, (b, config) in enumerate(zip(bodies, scene.bodies)):
         vertex_planes = surfaces.initial_planes(surface_set, b, b.initial_pose, 2.0 * b.radius)[0]
         # where it was placed, before a quasi-static body is settled on its load
@@ -370,7 +389,7 @@ def build_model(scene):
                  surfaces=surface_set,
                  quasi_static=quasi_static, dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
                  frame_steps=_even_steps(n_steps, run.frames), period=period,
-                 cycle_steps=cycle_steps, mechanism=mechanism)
+                 cycle_steps=cycle_steps, mechanism=mechanism, elastic=elastic)
 
 
 def _part_key(prefix, config):
@@ -651,7 +670,9 @@ def _faces_to_refine(scene, body, vertices, faces, surface_set):
         return None
     R = np.array(rotation_entries(np.asarray(body.orientation, float))).reshape(3, 3)
     points = vertices @ R.T + np.asarray(body.position, float) + Path(body.path).displacement(0.0)
-    reach = REFINE_REACH * float(np.linalg.norm(np.ptp(vertices, axis=0)))
+    reach = body.resolution_reach
+    if reach is None:
+        reach = REFINE_REACH * float(np.linalg.norm(np.ptp(vertices, axis=0)))
     return surfaces.contact_faces(points, faces, surface_set, reach)
 
 
@@ -711,7 +732,14 @@ def initial_state(model):
         at_rest[LAW_SLOTS.index("dt")] = 0.0
         for body, s in zip(model.bodies, state.bodies):
             s.pose[7:13] = 0.0
-            body_contact(model, body, s, at_rest)
+            if model.elastic is not None:
+                try:
+                    elastic_step(model, body, s, 0.0, s.pose[0:3].copy(), at_rest=True)
+                except PatchError as err:
+                    raise SceneError(model.scene.source, "contact.model", str(err)) from None
+                s.pose[7:13] = 0.0
+            else:
+                body_contact(model, body, s, at_rest)
     return state
 
 

@@ -39,6 +39,7 @@ UNITS = ("m", "mm", "cm", "um", "in")
 #: how a part's frames are written: a .pvd collection of .vtp files, or one VTKHDF file
 SERIES = ("pvd", "vtkhdf")
 MOTIONS = ("free", "guided", "prescribed", "fixed", "mechanism")
+CONTACT_MODELS = ("winkler", "half-space")
 SURFACE_TYPES = ("plane", "mesh", "cylinder", "sphere")
 SIDES = ("outside", "inside")
 #: keys of each primitive shape besides ``type``, and the required ones
@@ -121,6 +122,24 @@ def _check_mesh_or_shape(obj):
     _set_optional(obj, "path", _instance, PathConfig)
 
 
+def _poisson(key, value):
+    nu = _real(key, value)
+    if not 0.0 <= nu < 0.5:
+        raise SceneError("", key, f"must be in [0, 0.5), got {nu!r}")
+    return nu
+
+
+def _pair(key, value, check):
+    """One value for both parts, or [worn body, counter-surface]: a pair."""
+    if isinstance(value, (list, tuple)):
+        if len(value) != 2:
+            raise SceneError("", key, f"expected one value or two [body, surface], got "
+                             f"{_show(value)}")
+        return (check(key, value[0]), check(key, value[1]))
+    v = check(key, value)
+    return (v, v)
+
+
 # ------------------------------------------------------------------ dataclasses
 
 @dataclass(frozen=True, kw_only=True)
@@ -186,9 +205,41 @@ class ContactConfig:
     #: ``{youngs_modulus, poissons_ratio, thickness}``: the normal stiffness
     #: per area of an elastic layer (a Winkler foundation), instead of giving it
     layer: dict | None = None
+    #: "winkler" (a spring per vertex: the coefficients above) or
+    #: "half-space" (elastic bodies, docs/model.md "Elastic half-space")
+    model: str = "winkler"
+    #: Pa, and -: the half-space model's elastic constants, one value for the
+    #: worn bodies and the counter-surfaces alike or [worn body, counter-surface]
+    youngs_modulus: float | tuple | None = None
+    poissons_ratio: float | tuple | None = None
 
     def __post_init__(self):
         _set_optional(self, "margin", _length)
+        _set(self, "model", _choice, CONTACT_MODELS)
+        if self.model == "half-space":
+            for other in ("stiffness", "stiffness_per_area", "layer", "tangential_stiffness",
+                          "tangential_stiffness_per_area"):
+                if getattr(self, other) is not None:
+                    raise SceneError("", other, "does not apply to model = 'half-space' (its "
+                                     "stiffness follows from youngs_modulus and poissons_ratio)")
+            if self.youngs_modulus is None:
+                raise SceneError("", "youngs_modulus", "missing; model = 'half-space' needs the "
+                                 "Young's modulus of the parts (Pa): one value or [body, surface]")
+            object.__setattr__(self, "youngs_modulus", _pair("youngs_modulus", self.youngs_modulus,
+                                                             _positive))
+            object.__setattr__(self, "poissons_ratio", _pair(
+                "poissons_ratio", 0.3 if self.poissons_ratio is None else self.poissons_ratio,
+                _poisson))
+            # the Winkler foundation stands in where a reasoning needs one
+            # (the start's placement, a cycle jump's re-balance): E* over a
+            # length, replaced by the one equivalent to each solve
+            object.__setattr__(self, "stiffness_per_area", 1.0)
+        else:
+            for key in ("youngs_modulus", "poissons_ratio"):
+                if getattr(self, key) is not None:
+                    raise SceneError("", key, "applies to model = 'half-space' only (an elastic "
+                                     "layer on a Winkler foundation: layer = { youngs_modulus, "
+                                     "poissons_ratio, thickness })")
         if self.layer is not None:
             for other in ("stiffness", "stiffness_per_area"):
                 if getattr(self, other) is not None:
@@ -411,6 +462,9 @@ class BodyConfig:
     shape: ShapeConfig | None = None
     units: str = "m"
     resolution: float | None = None
+    #: m: ``resolution`` refines the faces within this distance of a surface
+    #: at the start (None: 10 % of the body's size)
+    resolution_reach: float | None = None
     density: float | None = None
     mass: float | None = None
     position: tuple = (0.0, 0.0, 0.0)
@@ -440,6 +494,9 @@ class BodyConfig:
         elif self.motion == "mechanism":
             raise SceneError("", "mechanism_body", "missing; motion = 'mechanism' needs the "
                              "name of the [mechanism] body the part rides on")
+        _set_optional(self, "resolution_reach", _length)
+        if self.resolution_reach is not None and self.resolution is None:
+            raise SceneError("", "resolution_reach", "applies with resolution only")
         _exclusive(self, "density", "mass")
         _set_optional(self, "density", _positive)
         _set_optional(self, "mass", _positive)
@@ -676,6 +733,13 @@ class Scene:
                 if b.motion == "free":
                     fail(f"body[{i}].motion", "'free' is not allowed with run.mode = "
                          "'quasi-static'; use guided, prescribed or fixed")
+        if self.contact.model == "half-space":
+            if self.run.mode != "quasi-static":
+                fail("contact.model", "'half-space' solves quasi-static contacts; set "
+                     "run.mode = 'quasi-static'")
+            if len(self.surfaces) != 1:
+                fail("contact.model", f"'half-space' takes one counter-surface, the scene has "
+                     f"{len(self.surfaces)}")
         riders = [(f"{kind}[{i}]", x) for kind, group in (("body", self.bodies),
                                                           ("surface", self.surfaces))
                   for i, x in enumerate(group) if x.mechanism_body is not None]

@@ -15,7 +15,7 @@ from functools import partial
 
 import numpy as np
 
-from . import stepper, surfaces
+from . import elastic, stepper, surfaces
 from .geometry import inverted_faces
 from .kernels.loop import deepest_penetration, impact_check, use_impact_room
 from .model import IMPACT_DEPTH, body_contact, wear_counters
@@ -79,6 +79,20 @@ def _quasi_static_step(model, body, s, k):
     # the planes under the vertices where the path puts the body, then the
     # balance along its free axis on them
     surfaces.update(model, body, s, t)
+    if model.elastic is not None:
+        try:
+            elastic.step(model, body, s, t, before)
+        except elastic.PatchError as err:
+            raise NumericalError(str(err)) from None
+        if surfaces.moved_since_refresh(model, body, s, t) >= s.cull[surfaces.CULL_MARGIN]:
+            # the balance moved it beyond its active set's bound: refresh it
+            # for the next step
+            surfaces.update(model, body, s, t)
+        if model.worn_counters:
+            too_deep = wear_counters(model, body, s, t)
+            if too_deep is not None:
+                raise counter_too_deep(model, *too_deep, t)
+        return
     settle = getattr(body.motion, "settle", None)
     if settle is not None:
         if not settle(s.pose, s.vertices, body.area_vectors, model.planes, s.vertex_planes,

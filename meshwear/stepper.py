@@ -23,7 +23,13 @@ def advance(model, state, until):
     moved by the model's dynamics (:mod:`meshwear.dynamics`: meshwear's own
     motions, or a MuJoCo mechanism)."""
     from .dynamics import UNSTABLE
-    from .simulate import NumericalError
+    from .simulate import NumericalError, step
+
+    if model.elastic is not None:
+        # the half-space solve is numpy's (meshwear.elastic): Python's steps
+        while state.step < until:
+            step(model, state)
+        return
 
     stopped = model.dynamics.advance(model, state, until,
                                      lambda k0, k1: _advance_bodies(model, state, k0, k1))
