@@ -44,7 +44,8 @@ from scipy import sparse
 from scipy.spatial import Delaunay, QhullError
 
 from . import halfspace
-from .kernels.contact import FACING, NO_CONTACT, SLIP, STICK
+from .kernels.contact import NO_CONTACT, SLIP, STICK
+from .kernels.elastic import gaps
 from .kernels.contact import FORCE as FORCE_SLOT
 from .kernels.laws import LAWS, name_of
 from .kernels.rigid import OSCILLATION, STEADY
@@ -54,14 +55,28 @@ from .surfaces.base import quaternion_matrix
 #: the normal problem is solved again when the gaps changed (rigid moves
 #: aside) by more than this fraction of the elastic approach
 RESOLVE = 1e-3
-#: relative tolerance of the conjugate-gradient solves (the traction's change)
+#: relative tolerance of the conjugate-gradient solves (the traction's
+#: change in an iteration): the normal one, taken seldom ...
 TOLERANCE = 1e-8
+#: ... and the tangential one, taken at every step of a partial slip from
+#: the last step's (Mindlin's force and Mindlin-Deresiewicz's energy agree
+#: to 1e-4 and 0.3 % at this and at 1e-8 alike: tests/test_elastic.py)
+SHEAR_TOLERANCE = 1e-4
 #: the band of gaps the first patch spans, in vertices of smallest gap
 FIRST_BAND_VERTICES = 64
 #: cells per side at most; a larger patch gets coarser cells
 MAX_CELLS = 192
-#: the elastic approach may use this fraction of the band, the rest is margin
-BAND_USE = 0.6
+#: the band of gaps a patch spans is the elastic approach over this (the
+#: contact lies where the gap is below the approach; the rest is margin) ...
+BAND_USE = 0.7
+#: ... and a patch is built again when the approach passes this fraction of
+#: its band, or falls below the next
+GROW_BAND, SHRINK_BAND = 0.9, 0.3
+#: tangential solves kept for a periodic stroke to repeat
+CACHE_STEPS = 1024
+#: two turning points whose shears differ by less than this fraction of the
+#: largest mu p are one (the solves' own tolerance is SHEAR_TOLERANCE)
+TURN_MATCH = 1e-3
 #: contact normals of a patch spreading wider than this (rad) are not a
 #: half-space contact: check warns ...
 WARN_SPREAD = 0.1
@@ -113,9 +128,23 @@ class Patch:
     turn_shift: float = 0.0
     direction: float = 0.0               # +1, -1: the branch's; 0: none yet
     reserve: np.ndarray = None           # the branch's last stick reserve (a warm start)
+    gross: bool = False                  # the last step slipped everywhere ...
+    gross_pressure: np.ndarray = None    # ... on this pressure
+    where: np.ndarray = None             # the patch's vertices' positions in the active set
+    outside: np.ndarray = None           # the active set's other positions
+    transposed: object = None            # weights.T, row-major
+    loaded: np.ndarray = None            # the patch's vertices that carry load ...
+    transposed_loaded: object = None     # ... and their rows of transposed
+    written: np.ndarray = None           # the vertices the last step gave a contact
     window: tuple = None                 # the cells the tangential problem is solved on
     shear_grid: object = None            # the grid of that window
     sliding: bool = False
+    # the tangential solves of this pressure, by the step they took (a
+    # periodic stroke repeats them)
+    cache: dict = field(default_factory=dict)
+    cache_pressure: np.ndarray = None
+    key: tuple = None                    # the shear's place in the cache ...
+    turn_key: tuple = None               # ... and its branch's turning point's
     extra: dict = field(default_factory=dict)
 
 
@@ -143,61 +172,46 @@ def _stroke(motion):
     return None
 
 
-def pair_geometry(model, body, s, index):
-    """For the vertices ``index``: their gap (m, along the normal of the
-    plane under each; inf where none faces them), the plane's normal
-    (k, 3, world), the vertex's contact area on it (m²), its world
-    offset from the centre of mass and its velocity relative to the
-    surface (k, 3)."""
-    R = quaternion_matrix(s.pose[3:7])
-    r = s.vertices[index] @ R.T
-    x = s.pose[0:3] + r
-    P = model.planes.shape[0]
-    if P:
-        o = np.broadcast_to(model.planes[0, 0], x.shape)
-        n = np.broadcast_to(model.planes[0, 1], x.shape)
-        v_surface = np.broadcast_to(model.planes[0, 2], x.shape)
-    else:
-        o = s.vertex_planes[0, index, 0]
-        n = s.vertex_planes[0, index, 1]
-        v_surface = s.vertex_planes[0, index, 2]
-    gap = np.einsum("ij,ij->i", x - o, n)
-    if P and np.any(model.planes[0, 3] != 0.0):
-        foot = x - gap[:, None] * n
-        v_surface = v_surface + np.cross(model.planes[0, 3], foot - model.planes[0, 0])
-    world_area = body.area_vectors[index, 0:3] @ R.T
-    area = -np.einsum("ij,ij->i", world_area, n)
-    facing = (area > FACING * body.area_vectors[index, 3]) & np.any(n != 0.0, axis=1)
-    gap = np.where(facing, gap, np.inf)
-    velocity = s.pose[7:10] + np.cross(s.pose[10:13], r) - v_surface
-    return gap, np.ascontiguousarray(n), area, r, velocity
+def pair_geometry(model, body, s, active):
+    """For the ``active`` vertices (k,) against the one counter-surface:
+    gap, normal, contact area, offset and velocity relative to the
+    surface (:func:`meshwear.kernels.elastic.gaps`)."""
+    k = len(active)
+    gap, area = np.empty(k), np.empty(k)
+    n, r, velocity = np.empty((k, 3)), np.empty((k, 3)), np.empty((k, 3))
+    gaps(s.vertices, s.pose, model.planes, s.vertex_planes, active, body.area_vectors, gap, n,
+         area, r, velocity)
+    return gap, n, area, r, velocity
 
 
-def _build_patch(patch, body, s, index, gap, r, area, n, hmin):
+def _build_patch(patch, active, gap, r, area, hmin):
     """Grid and interpolation weights over the vertices whose gap is within
-    the band (the triangles reach twice as far, so the grid's cells are
-    all inside them)."""
+    the band, and the vertices whose triangles cover the grid's box;
+    returns their positions in ``active``."""
     e1, e2 = patch.e1, patch.e2
-    inside = gap - hmin <= patch.band
-    reach = gap - hmin <= 2.0 * patch.band
-    coords = np.column_stack([r @ e1, r @ e2])
-    spacing = float(np.sqrt(np.median(area[inside])))
-    lo, hi = coords[inside].min(axis=0), coords[inside].max(axis=0)
-    lo, hi = lo - 2.0 * spacing, hi + 2.0 * spacing
+    near = np.flatnonzero(gap - hmin <= 2.0 * patch.band)
+    coords = np.column_stack([r[near] @ e1, r[near] @ e2])
+    core = gap[near] - hmin <= patch.band
+    spacing = float(np.sqrt(np.median(area[near][core])))
+    lo, hi = coords[core].min(axis=0) - 2.0 * spacing, coords[core].max(axis=0) + 2.0 * spacing
+    # the vertices whose triangles cover the grid's box
+    box = np.all((coords >= lo - 3.0 * spacing) & (coords <= hi + 3.0 * spacing), axis=1)
+    take, coords = near[box], coords[box]
     cells = np.ceil((hi - lo) / spacing).astype(int)
     if cells.max() > MAX_CELLS:
         spacing *= cells.max() / MAX_CELLS
         cells = np.ceil((hi - lo) / spacing).astype(int)
     cells = np.maximum(cells, 4)
-    take = np.flatnonzero(reach)
     try:
-        tri = Delaunay(coords[take])
+        tri = Delaunay(coords)
     except QhullError:
-        raise PatchError(f"body {body.name!r}: its contact patch has too few vertices "
-                         f"({len(take)}) to span a grid; refine the body (resolution)") from None
+        raise PatchError(f"the contact patch has too few vertices ({len(take)}) to span a "
+                         "grid; refine the body (resolution)") from None
     origin = lo + 0.5 * spacing
-    grid = halfspace.make_grid(tuple(cells), spacing, patch.extra["youngs"],
-                               patch.extra["poisson"])
+    old = patch.extra.get("old")
+    patch.grid = halfspace.make_grid(tuple(cells), spacing, patch.extra["youngs"],
+                                     patch.extra["poisson"])
+    patch.origin = origin
     axes = [origin[j] + spacing * np.arange(cells[j]) for j in range(2)]
     cx, cy = np.meshgrid(*axes, indexing="ij")
     centres = np.column_stack([cx.ravel(), cy.ravel()])
@@ -208,13 +222,13 @@ def _build_patch(patch, body, s, index, gap, r, area, n, hmin):
     bary = np.column_stack([b, 1.0 - b.sum(axis=1)])
     rows = np.repeat(np.flatnonzero(ok), 3)
     cols = tri.simplices[simplex[ok]].ravel()
-    weights = sparse.csr_matrix((bary.ravel(), (rows, cols)),
-                                shape=(len(centres), len(take)))
-    old = (patch.grid, patch.origin) if patch.grid is not None else patch.extra.get("old")
-    patch.grid, patch.origin = grid, origin
-    patch.index = index[take]
-    patch.coords = coords[take]
+    weights = sparse.csr_matrix((bary.ravel(), (rows, cols)), shape=(len(centres), len(take)))
+    patch.index = active[take]
+    patch.where = take
+    patch.outside = np.setdiff1d(np.arange(len(active)), take, assume_unique=True)
+    patch.coords = coords
     patch.weights = weights
+    patch.transposed = weights.T.tocsr()
     patch.allowed = ok.reshape(cells)
     patch.pressure = None
     if old is not None:
@@ -224,10 +238,21 @@ def _build_patch(patch, body, s, index, gap, r, area, n, hmin):
     return take
 
 
-def _same_patch(patch, index, coords):
-    return (patch.index is not None and len(index) == len(patch.index)
-            and np.array_equal(index, patch.index)
-            and np.abs(coords - patch.coords).max() <= 1e-6 * patch.grid.spacing[0])
+def _locate(patch, active, r):
+    """The positions in ``active`` of the patch's vertices, or None where
+    the active set or the vertices' tangent coordinates changed."""
+    where = patch.where
+    if where is None or where.max(initial=-1) >= len(active) or not np.array_equal(
+            active[where], patch.index):
+        where = np.minimum(np.searchsorted(active, patch.index), len(active) - 1)
+        if not np.array_equal(active[where], patch.index):
+            return None
+        patch.where = where
+        patch.outside = np.setdiff1d(np.arange(len(active)), where, assume_unique=True)
+    rw = r[where]
+    drift = max(np.abs(rw @ patch.e1 - patch.coords[:, 0]).max(),
+                np.abs(rw @ patch.e2 - patch.coords[:, 1]).max())
+    return where if drift <= 1e-6 * patch.grid.spacing[0] else None
 
 
 def step(model, body, s, t, before, at_rest=False):
@@ -235,186 +260,128 @@ def step(model, body, s, t, before, at_rest=False):
     elastic half-space, after :func:`meshwear.simulate._quasi_static_step`
     placed it on its path (``before``: its position at the step's start)
     and updated its surfaces: normal and tangential tractions, the load
-    balance, wear. Fills the same state arrays as the Winkler kernel."""
+    balance, wear. Fills the same state arrays as the Winkler kernel. ``at_rest``:
+    a step of no duration (the t = 0 state): nothing slips or wears."""
     elastic = model.elastic
     motion = body.motion
     active = s.active
     gap, n, area, r, velocity = pair_geometry(model, body, s, active)
     if at_rest:
         velocity[:] = 0.0
-    facing = np.isfinite(gap)
-    s.normal_force[:, active] = 0.0
-    s.tangential[:, active, FORCE_SLOT] = 0.0
-    s.contact_state[:, active] = NO_CONTACT
+    patch = s.elastic
+    if patch is not None and patch.written is not None:
+        # the last step's contacts: this step writes its own
+        w = patch.written
+        s.normal_force[0, w] = 0.0
+        s.tangential[0, w, FORCE_SLOT] = 0.0
+        s.contact_state[0, w] = NO_CONTACT
+        patch.written = None
     s.wrench[:] = 0.0
-    if not facing.any():
-        if isinstance(motion, BalancedMotion):
+    balanced = isinstance(motion, BalancedMotion)
+    hmin = float(gap.min()) if len(gap) else np.inf
+    if not np.isfinite(hmin):
+        if balanced:
             raise PatchError(f"body {body.name!r}: no contact carries its load at t = {t:.6g} s")
         return
-    patch = s.elastic
-    first = patch is None
-    if first:
-        normal = n[np.argmin(gap)]
+    if patch is None:
+        normal = n[np.argmin(gap)].copy()
         stroke = _stroke(motion)
         e1 = _perpendicular(normal, stroke if stroke is not None else np.array([1.0, 0, 0]))
         patch = s.elastic = Patch(e1=e1, e2=np.cross(normal, e1), normal=normal)
         patch.extra.update(youngs=elastic.youngs, poisson=elastic.poisson)
-    hmin = float(gap[facing].min())
-    balanced = isinstance(motion, BalancedMotion)
     beta = float(motion.axis @ patch.normal) if balanced else 1.0
     if balanced and beta <= 0.1:
-        raise PatchError(f"body {body.name!r}: its free axis is {np.degrees(np.arccos(max(beta, -1.0))):.0f}° "
-                         "from the contact normal; the half-space model balances the load along "
-                         "the normal (give free_axis along it)")
+        raise PatchError(f"body {body.name!r}: its free axis is "
+                         f"{np.degrees(np.arccos(max(beta, -1.0))):.0f}° from the contact normal; "
+                         "the half-space model balances the load along the normal (give "
+                         "free_axis along it)")
     load = motion.carried / beta if balanced else None
-    coords = np.column_stack([r @ patch.e1, r @ patch.e2])
     shift_move = 0.0
-    solved = False
     for _ in range(8):
-        if patch.grid is None:
-            if patch.band == 0.0:
-                k = min(FIRST_BAND_VERTICES, int(facing.sum()))
-                patch.band = 2.0 * float(np.partition(gap[facing] - hmin, k - 1)[k - 1]) + 1e-30
-            take = _build_patch(patch, body, s, active, gap, r, area, n, hmin)
-            heights = gap[take]
-        else:
-            where = np.searchsorted(active, patch.index)
-            where = np.minimum(where, len(active) - 1)
-            if not (np.array_equal(active[where], patch.index)
-                    and np.all(np.isfinite(gap[where]))
-                    and np.abs(coords[where] - patch.coords).max() <= 1e-6 * patch.grid.spacing[0]):
+        take = None if patch.grid is None else _locate(patch, active, r)
+        if take is None:
+            if patch.grid is not None:
                 _drop_grid(patch)
-                continue
-            take = where
-            heights = gap[take]
-        if patch.pressure is not None and not solved:
+            if patch.band == 0.0:
+                finite = gap[np.isfinite(gap)] - hmin
+                k = min(FIRST_BAND_VERTICES, len(finite))
+                patch.band = 2.0 * float(np.partition(finite, k - 1)[k - 1]) + 1e-30
+            take = _build_patch(patch, active, gap, r, area, hmin)
+        heights = gap[take]
+        if not np.all(np.isfinite(heights)):
+            _drop_grid(patch)
+            continue
+        outside = float(gap[patch.outside].min(initial=np.inf))
+        if patch.pressure is not None:
             change = heights - patch.heights
             # a guided body's rigid move along the normal is balanced away
-            common = float(np.median(change)) if balanced else 0.0
-            if np.abs(change - common).max() <= RESOLVE * max(patch.approach - patch.heights.min(), 0.0):
+            common = float(np.median(change[patch.loaded])) if balanced else 0.0
+            if (np.abs(change - common).max()
+                    <= RESOLVE * max(patch.approach - patch.heights.min(), 0.0)
+                    and outside > patch.approach + common):
                 # the same contact moved rigidly: the approach follows
                 shift_move = common
                 break
-        cell_gap = patch.weights @ heights
-        cell_gap = cell_gap.reshape(patch.allowed.shape)
-        cell_gap = np.where(patch.allowed, cell_gap, np.inf)
-        if balanced:
-            solution = halfspace.solve(patch.grid, np.where(patch.allowed, cell_gap, 0.0), load,
-                                       mask=patch.allowed, start=patch.pressure, tol=TOLERANCE)
-        else:
-            solution = halfspace.solve(patch.grid, np.where(patch.allowed, cell_gap, 0.0), None,
-                                       mask=patch.allowed, start=patch.pressure, tol=TOLERANCE,
-                                       approach=0.0)
+        cell_gap = (patch.weights @ heights).reshape(patch.allowed.shape)
+        cell_gap = np.where(patch.allowed, cell_gap, 0.0)
+        solution = halfspace.solve(patch.grid, cell_gap, load, mask=patch.allowed,
+                                   start=patch.pressure, tol=TOLERANCE,
+                                   approach=None if balanced else 0.0)
         patch.solves += 1
         patch.iterations += solution.iterations
-        used = solution.approach - hmin if balanced else -hmin
-        if used > BAND_USE * patch.band:
-            patch.band = used / BAND_USE * 1.5
+        used = solution.approach - hmin
+        pressed = solution.traction > 0.0
+        if used > GROW_BAND * patch.band or outside <= solution.approach:
+            patch.band = used / BAND_USE
             _drop_grid(patch)
             continue
-        pressed = solution.traction > 0.0
         if pressed.any() and (pressed[0].any() or pressed[-1].any() or pressed[:, 0].any()
                               or pressed[:, -1].any()):
             patch.band *= 2.0
             _drop_grid(patch)
             continue
-        if used < 0.15 * patch.band and used > 0.0 and patch.solves > 1:
+        if 0.0 < used < SHRINK_BAND * patch.band and patch.solves > 1:
             # the contact shrank well inside its patch: a smaller grid
-            patch.band = used / BAND_USE * 1.5
+            patch.band = used / BAND_USE
             _drop_grid(patch)
             continue
         _new_pressure(patch, solution, heights)
-        patch.spread = _spread(body, s, patch, take, n)
+        patch.spread = _spread(body, s, patch, n[take])
         if patch.spread > REFUSE_SPREAD:
             raise PatchError(
                 f"body {body.name!r}: its contact spans {np.degrees(patch.spread):.0f}° of "
                 f"surface normal at t = {t:.6g} s: a conforming contact (a shaft in a "
                 "bushing), not a half-space one; use contact.model = 'winkler'")
-        solved = True
-        shift_move = 0.0
         break
     else:
-        raise PatchError(f"body {body.name!r}: the half-space patch did not settle at t = {t:.6g} s")
-    idx = patch.index
-    F = patch.forces
+        raise PatchError(f"body {body.name!r}: the half-space patch did not settle at "
+                         f"t = {t:.6g} s")
+    # from here on, the vertices that carry load only
+    on = patch.loaded
+    idx = patch.index[on]
+    F = patch.forces[on]
+    at = take[on]
     approach = patch.approach + shift_move
+    velocity = velocity[at]
     if balanced:
         # the load balance: the body approaches by the solve's approach
         z = -approach / beta
         s.pose[0:3] += z * motion.axis
         if not at_rest:
             s.pose[7:10] = (s.pose[0:3] - before) / model.dt
-            velocity = velocity + (z / model.dt) * motion.axis
-    # the tangential problem
-    k_area = area[take]
-    normal_world = n[take]
-    slip_v = velocity[take] - np.einsum("ij,ij->i", velocity[take], normal_world)[:, None] * normal_world
-    mu = elastic.friction
-    energy = np.zeros(len(idx))
-    friction = np.zeros((len(idx), 3))
-    state = np.where(F > 0.0, SLIP, NO_CONTACT).astype(np.int8)
-    mean_v = slip_v[F > 0.0].mean(axis=0) if (F > 0.0).any() else np.zeros(3)
-    uniform = (np.abs(slip_v[F > 0.0] - mean_v).max(initial=0.0)
-               <= 1e-9 * np.linalg.norm(mean_v) + 1e-300)
-    along = abs(mean_v @ patch.e2) <= 1e-9 * np.linalg.norm(mean_v) + 1e-300
-    area_cell = patch.grid.cell_area
-    if uniform and along and mu > 0.0:
-        patch.sliding = False
-        move = float(mean_v @ patch.e1) * model.dt
-        q_old = patch.shear if patch.shear is not None else np.zeros(patch.allowed.shape)
-        limit = mu * patch.pressure
-        q_old = np.clip(q_old, -limit, limit)
-        if move != 0.0:
-            direction = 1.0 if move > 0.0 else -1.0
-            if direction != patch.direction:
-                patch.turn, patch.turn_shift = q_old, patch.shift
-                patch.direction, patch.reserve = direction, None
-            patch.turn = np.clip(patch.turn, -limit, limit)
-            patch.shift += move
-            # on the cells around the contact only (the shear is zero elsewhere)
-            win, grid = patch.window, patch.shear_grid
-            q_win, stick_win, w = halfspace.shear_at_shift(
-                grid, patch.pressure[win], mu, patch.shift, patch.turn[win], patch.turn_shift,
-                start=patch.reserve, tol=TOLERANCE)
-            patch.reserve = w
-            # each cell's slip: the stroke less the surfaces' elastic stretch
-            slip = move - grid.convolve(q_win - q_old[win], "shear")
-            q = np.zeros_like(q_old)
-            q[win] = q_win
-            stick = np.zeros(q.shape, bool)
-            stick[win] = stick_win
-            cell_energy = np.zeros_like(q_old)
-            # (a slipping cell's shear is its limit, mu p, all the step)
-            cell_energy[win] = np.where(stick_win, 0.0, np.maximum(q_win * slip, 0.0)) * area_cell
-            energy = patch.weights.T @ cell_energy.ravel()
-        else:
-            q = q_old
-            stick = (patch.pressure > 0.0) & (np.abs(q) < limit * (1.0 - 1e-9))
-        patch.shear = q
-        shear_force = patch.weights.T @ (q.ravel() * area_cell)
-        friction = -shear_force[:, None] * patch.e1
-        stuck = patch.weights.T @ (stick.ravel() * 1.0)
-        share = patch.weights.T @ ((patch.pressure > 0.0).ravel() * 1.0)
-        state = np.where(F > 0.0, np.where(stuck > 0.5 * share, STICK, SLIP), NO_CONTACT)
-    else:
-        # sliding: Coulomb at every vertex against its own slip velocity
-        patch.sliding = True
-        patch.shear, patch.direction = None, 0.0
-        speed = np.linalg.norm(slip_v, axis=1)
-        moving = speed > 0.0
-        friction[moving] = -(mu * F[moving] / speed[moving])[:, None] * slip_v[moving]
-        energy = mu * F * speed * model.dt
-        state = np.where(F > 0.0, np.where(moving, SLIP, STICK), NO_CONTACT)
+            velocity += (z / model.dt) * motion.axis
+    k_area = area[at]
+    normal_world = n[at]
+    slip_v = velocity - np.einsum("ij,ij->i", velocity, normal_world)[:, None] * normal_world
+    energy, friction, state = _tangential(model, patch, F, slip_v, elastic.friction, at_rest)
     # wear: the law on each vertex's energy, load and slip
+    mu = elastic.friction
     law = LAWS[name_of(int(model.law[2]))]
-    slip_distance = np.where((F > 0.0) & (mu > 0.0), energy / np.maximum(mu * F, 1e-300), 0.0)
-    contact_area = np.where(k_area > 0.0, k_area, 1.0)
-    dw, dv = law.twin(model.law[3], energy, F, slip_distance, contact_area)
-    dw = np.where(F > 0.0, dw, 0.0)
-    dv = np.where(F > 0.0, dv, 0.0)
-    R = quaternion_matrix(s.pose[3:7])
+    slip_distance = energy / (mu * F) if mu > 0.0 else np.zeros(len(F))
+    dw, dv = law.twin(model.law[3], energy, F, slip_distance, np.where(k_area > 0.0, k_area, 1.0))
     worn = dw > 0.0
     if worn.any():
+        R = quaternion_matrix(s.pose[3:7])
         if body.wear_direction.shape[0]:
             direction = body.wear_direction[idx[worn]]
         else:
@@ -426,18 +393,128 @@ def step(model, body, s, t, before, at_rest=False):
     s.normal_force[0, idx] = F
     s.tangential[0, idx, FORCE_SLOT] = friction
     s.contact_state[0, idx] = state
+    patch.written = idx
     forces = F[:, None] * normal_world + friction
     s.wrench[0:3] = forces.sum(axis=0)
-    s.wrench[3:6] = np.cross(r[take], forces).sum(axis=0)
+    s.wrench[3:6] = np.cross(r[at], forces).sum(axis=0)
     if s.load.shape[1]:
         s.load[0, idx] += F
         s.load[1, idx] += F * F
-    # the Winkler foundation equivalent to this contact, for what reasons
-    # with one (a cycle jump's re-balance): the load over the overlaps
-    overlap = np.maximum(approach - patch.heights, 0.0)
-    if (F > 0.0).any() and float(overlap @ (k_area * overlap)) > 0.0:
-        model.law[6] = float(F @ overlap) / float(overlap @ (k_area * overlap))
-        model.law[5] = 0.0
+    if not patch.extra.get("foundation"):
+        # the Winkler foundation equivalent to the first contact, for what
+        # reasons with one (a cycle jump's re-balance, its wear per unit of
+        # penetration): its load over its overlaps; kept for the run, so
+        # that the jumps' measurements compare from cycle to cycle
+        overlap = np.maximum(approach - heights[on], 0.0)
+        stiff = float(overlap @ (k_area * overlap))
+        if len(F) and stiff > 0.0:
+            model.law[6] = float(F @ overlap) / stiff
+            model.law[5] = 0.0
+            patch.extra["foundation"] = True
+
+
+def _tangential(model, patch, F, slip_v, mu, at_rest):
+    """Friction energy (J), force (k, 3, N, on the body) and contact state
+    of the patch's loaded vertices (their forces ``F``, slip velocities
+    ``slip_v``) in the step: Cattaneo-Mindlin on the grid for a
+    uniform slip along its first axis, else Coulomb at every vertex."""
+    T = patch.transposed_loaded
+    if not len(F) or at_rest:
+        state = np.full(len(F), STICK, np.int8)
+        friction = np.zeros((len(F), 3))
+        if patch.shear is not None and len(F):
+            friction = -(T @ (patch.shear.ravel() * patch.grid.cell_area))[:, None] * patch.e1
+        return np.zeros(len(F)), friction, state
+    mean_v = slip_v.mean(axis=0)
+    speed = float(np.linalg.norm(mean_v))
+    uniform = np.abs(slip_v - mean_v).max() <= 1e-9 * speed + 1e-300
+    along = abs(mean_v @ patch.e2) <= 1e-9 * speed + 1e-300
+    area_cell = patch.grid.cell_area
+    if not (uniform and along and mu > 0.0):
+        # sliding: Coulomb at every vertex against its own slip velocity
+        patch.sliding = True
+        patch.shear, patch.direction, patch.gross = None, 0.0, False
+        speeds = np.linalg.norm(slip_v, axis=1)
+        moving = speeds > 0.0
+        friction = np.zeros((len(F), 3))
+        friction[moving] = -(mu * F[moving] / speeds[moving])[:, None] * slip_v[moving]
+        state = np.where(moving, SLIP, STICK).astype(np.int8)
+        return mu * F * speeds * model.dt, friction, state
+    patch.sliding = False
+    move = float(mean_v @ patch.e1) * model.dt
+    limit = mu * patch.pressure
+    q_old = patch.shear if patch.shear is not None else np.zeros(limit.shape)
+    energy = np.zeros(len(F))
+    if move == 0.0:
+        q = np.clip(q_old, -limit, limit)
+        stick = (patch.pressure > 0.0) & (np.abs(q) < limit * (1.0 - 1e-9))
+    else:
+        direction = 1.0 if move > 0.0 else -1.0
+        if patch.cache_pressure is not patch.pressure:
+            # a new pressure: what was solved on the old one does not repeat
+            patch.cache, patch.cache_pressure = {}, patch.pressure
+            patch.key = patch.turn_key = ("fresh", patch.solves, patch.shift)
+        if direction != patch.direction:
+            patch.turn, patch.turn_shift = np.clip(q_old, -limit, limit), patch.shift
+            patch.direction, patch.reserve, patch.gross = direction, None, False
+            # a turning point met before (the same shear at the same shift:
+            # Mindlin and Deresiewicz's loop closes after its first cycle)
+            # takes that one's place in the cache
+            patch.turn_key = patch.key
+            seen = patch.cache.setdefault(("turn", round(patch.shift * 1e15)), [])
+            close = TURN_MATCH * float(limit.max())
+            for key_seen, q_seen in seen:
+                if np.abs(q_seen - patch.turn).max() <= close:
+                    patch.turn_key = patch.key = key_seen
+                    break
+            else:
+                seen.append((patch.key, patch.turn))
+        patch.shift += move
+        # a periodic stroke on an unchanged pressure repeats its steps: the
+        # shear of a branch depends on its turning point and the shift only
+        # (and each cell's energy on the step's start as well)
+        key = (patch.key, direction, round(patch.shift * 1e15))
+        hit = patch.cache.get(key)
+        if hit is not None:
+            q, stick, cell_energy, patch.key = hit
+            patch.reserve = None
+        elif patch.gross and patch.gross_pressure is patch.pressure:
+            # still sliding the same way on the same pressure: every cell
+            # stays at its limit and slips by the whole move
+            q = direction * limit
+            stick = np.zeros(q.shape, bool)
+            cell_energy = limit * abs(move) * area_cell
+        else:
+            patch.turn = np.clip(patch.turn, -limit, limit)
+            # on the cells around the contact only (the shear is zero elsewhere)
+            win, grid = patch.window, patch.shear_grid
+            q_win, stick_win, w = halfspace.shear_at_shift(
+                grid, patch.pressure[win], mu, patch.shift, patch.turn[win], patch.turn_shift,
+                start=patch.reserve, tol=SHEAR_TOLERANCE)
+            patch.reserve = w
+            # each cell's slip: the stroke less the surfaces' elastic stretch
+            # (a slipping cell's shear is its limit, mu p, all the step)
+            slip = move - grid.convolve(q_win - np.clip(q_old, -limit, limit)[win], "shear")
+            q = np.zeros(limit.shape)
+            q[win] = q_win
+            stick = np.zeros(q.shape, bool)
+            stick[win] = stick_win
+            cell_energy = np.zeros(limit.shape)
+            cell_energy[win] = np.where(stick_win, 0.0, np.maximum(q_win * slip, 0.0)) * area_cell
+            patch.gross = not stick_win.any()
+            patch.gross_pressure = patch.pressure
+        if hit is None:
+            new_key = (patch.turn_key, round(patch.shift * 1e15))
+            if len(patch.cache) >= CACHE_STEPS:
+                patch.cache.clear()
+            patch.cache[key] = (q, stick, cell_energy, new_key)
+            patch.key = new_key
+        energy = T @ cell_energy.ravel()
+    patch.shear = q
+    friction = -(T @ (q.ravel() * area_cell))[:, None] * patch.e1
+    stuck = T @ stick.ravel().astype(float)
+    share = T @ (patch.pressure > 0.0).ravel().astype(float)
+    return energy, friction, np.where(stuck > 0.5 * share, STICK, SLIP).astype(np.int8)
 
 
 def _drop_grid(patch):
@@ -448,7 +525,7 @@ def _drop_grid(patch):
     patch.grid = None
 
 
-def _spread(body, s, patch, take, n):
+def _spread(body, s, patch, n):
     """The largest angle (rad) between the contact normal and the body's or
     the surface's normal at a vertex that carries load."""
     pressed = patch.forces > 0.0
@@ -457,7 +534,7 @@ def _spread(body, s, patch, take, n):
     R = quaternion_matrix(s.pose[3:7])
     idx = patch.index[pressed]
     outward = body.area_vectors[idx, 0:3] @ R.T / body.area_vectors[idx, 3:4]
-    cosines = np.concatenate([-(outward @ patch.normal), n[take][pressed] @ patch.normal])
+    cosines = np.concatenate([-(outward @ patch.normal), n[pressed] @ patch.normal])
     return float(np.arccos(np.clip(cosines, -1.0, 1.0)).max())
 
 
@@ -482,7 +559,9 @@ def _new_pressure(patch, solution, heights):
     patch.pressure = solution.traction
     patch.heights = heights.copy()
     patch.approach = solution.approach
-    patch.forces = patch.weights.T @ (solution.traction.ravel() * patch.grid.cell_area)
+    patch.forces = patch.transposed @ (solution.traction.ravel() * patch.grid.cell_area)
+    patch.loaded = np.flatnonzero(patch.forces > 0.0)
+    patch.transposed_loaded = patch.transposed[patch.loaded]
     # the window of cells the tangential problem needs: the pressed ones
     pressed = np.argwhere(solution.traction > 0.0)
     if len(pressed):
