@@ -132,7 +132,46 @@ def plot_pin_on_disc(case):
     return save(fig, "pin_on_disc_volume.png")
 
 
-PLOTS = {"sphere_pin": plot_profile, "jenkins_quasi_static": plot_loop,
+def plot_hertz(case):
+    d = case.data
+    r = np.linspace(0.0, d["a"], 200)
+    fig, ax = plt.subplots(figsize=(5, 3.6))
+    ax.plot(1e6 * d["r_cells"], 1e-9 * d["p_cells"], ".", ms=2, color="0.6", label="grid cells")
+    ax.plot(1e6 * d["r_vertices"], 1e-9 * d["p_vertices"], ".", ms=3,
+            label="vertices (force / contact area)")
+    ax.plot(1e6 * r, 1e-9 * d["p0"] * np.sqrt(1.0 - (r / d["a"]) ** 2), "k-", lw=1,
+            label="Hertz")
+    ax.set_xlabel("distance from the axis (µm)")
+    ax.set_ylabel("pressure (GPa)")
+    ax.set_title("Ball on flat, half-space: R = 5 mm, P = 10 N")
+    ax.legend(fontsize=8)
+    return save(fig, "hertz_ball.png")
+
+
+def plot_mindlin(case):
+    d = case.data
+    mu_p, gross, stroke, x = d["mu_P"], d["gross"], d["stroke"], d["x"]
+    top = x * mu_p
+    q = np.linspace(-top, top, 200)
+    # the two branches of Mindlin and Deresiewicz's loop
+    down = stroke - 2.0 * gross * (1.0 - (1.0 - (top - q) / (2.0 * mu_p)) ** (2.0 / 3.0))
+    up = -stroke + 2.0 * gross * (1.0 - (1.0 - (q + top) / (2.0 * mu_p)) ** (2.0 / 3.0))
+    first = np.linspace(0.0, top, 100)
+    fig, ax = plt.subplots(figsize=(5, 3.6))
+    ax.plot(1e6 * d["shift"], d["force"], "o-", ms=3, lw=0.8, label="meshwear, 8 steps a cycle")
+    ax.plot(1e6 * down, q, "k-", lw=1, label="Mindlin-Deresiewicz")
+    ax.plot(1e6 * up, q, "k-", lw=1)
+    ax.plot(1e6 * gross * (1.0 - (1.0 - first / mu_p) ** (2.0 / 3.0)), first, "k:", lw=1,
+            label="Cattaneo-Mindlin, first loading")
+    ax.set_xlabel("stroke (µm)")
+    ax.set_ylabel("tangential force Q (N)")
+    ax.set_title("Ball on flat in partial slip, half-space")
+    ax.legend(fontsize=8)
+    return save(fig, "mindlin_loop.png")
+
+
+PLOTS = {"hertz_ball": plot_hertz, "mindlin_fretting": plot_mindlin,
+         "sphere_pin": plot_profile, "jenkins_quasi_static": plot_loop,
          "winkler_sphere": plot_approach, "tilted_punch": plot_decay,
          "mesh_independence": plot_mesh, "pin_on_disc": plot_pin_on_disc}
 
@@ -281,6 +320,26 @@ def sections(results, images):
         "converge as the mesh is refined, and the pressure is a real pressure. Use *per",
         "point* only to reproduce the published model or a calibration made with it on",
         "the same mesh: its coefficients belong to one mesh.",
+        "",
+        "## Elastic half-space: Hertz",
+        "",
+        "The ball with `[contact] model = \"half-space\"` (E = 210 GPa, ν = 0.3 for both",
+        "parts): its vertices' gaps on the grid, the pressure solved, the forces taken",
+        "back to the vertices ([the model](model.md#in-a-run)). The grid's pressure is",
+        "Hertz's ellipse; each vertex's force over its contact area scatters about it",
+        "by a few per cent (its share of the cells follows its triangles, its area the",
+        "mesh's barycentric one), and the vertices carry the load exactly.",
+        "",
+        f"![Hertz pressure]({images['hertz_ball']})",
+        "",
+        "## Elastic half-space: Cattaneo-Mindlin and Mindlin-Deresiewicz",
+        "",
+        "The same ball rubbed below gross slip, 8 steps a cycle: the tangential force",
+        "against the stroke follows Mindlin's first loading and Mindlin and",
+        "Deresiewicz's loop (each step solved at its stroke: the loop does not depend",
+        "on the step, only on the turning points being steps).",
+        "",
+        f"![fretting loop]({images['mindlin_fretting']})",
     ]
     return out
 

@@ -306,8 +306,106 @@ def mesh_independence(levels=(4, 5, 6), duration=2.0):
     return Case("mesh_independence", VALIDATION / "sphere_pin.toml", rows, out)
 
 
+def _hertz(scene):
+    """Hertz's a, p0 and approach for the half-space ball ``scene``."""
+    from meshwear.halfspace import contact_modulus
+
+    c = scene.contact
+    e_star = contact_modulus(c.youngs_modulus, c.poissons_ratio)
+    R, P = scene.bodies[0].shape.radius, -scene.bodies[0].force[2]
+    a = (3.0 * P * R / (4.0 * e_star)) ** (1.0 / 3.0)
+    return a, 3.0 * P / (2.0 * np.pi * a * a), a * a / R, P
+
+
+def ellipse_radius(r2, values):
+    """Radius and height of the ellipse ``values^2 = h^2 (1 - r^2 / radius^2)``
+    fitted (least squares on the squares) to the positive ``values``."""
+    pos = values > 0.0
+    slope, intercept = np.polyfit(r2[pos], values[pos] ** 2, 1)
+    return float(np.sqrt(-intercept / slope)), float(np.sqrt(intercept))
+
+
+def cell_radii(patch):
+    """Squared distance of each grid cell of a half-space patch from the
+    patch's axis (m²)."""
+    h = patch.grid.spacing[0]
+    x = patch.origin[0] + h * np.arange(patch.grid.shape[0])
+    y = patch.origin[1] + h * np.arange(patch.grid.shape[1])
+    X, Y = np.meshgrid(x, y, indexing="ij")
+    return X * X + Y * Y
+
+
+def hertz_ball():
+    """A ball pressed on a flat, half-space contact: Hertz's ellipse."""
+    from meshwear.model import build_model, initial_state
+
+    scene = load_scene(VALIDATION / "hertz_ball.toml")
+    model = build_model(scene)
+    state = initial_state(model)
+    patch = state.bodies[0].elastic
+    a, p0, approach, _ = _hertz(scene)
+    r2 = cell_radii(patch)
+    radius, peak = ellipse_radius(r2, patch.pressure)
+    case = "Hertz ball, half-space"
+    rows = [Row(case, "contact radius (ellipse fitted to the pressure)", a, radius, 1e-2, "m"),
+            Row(case, "peak pressure (the fitted ellipse's)", p0, peak, 1e-2, "Pa"),
+            Row(case, "approach", approach, patch.approach - patch.heights.min(), 1e-2, "m")]
+    s, b = state.bodies[0], model.bodies[0]
+    loaded = s.normal_force[0] > 0.0
+    return Case("hertz_ball", VALIDATION / "hertz_ball.toml", rows,
+                {"a": a, "p0": p0, "r_cells": np.sqrt(r2[patch.pressure > 0.0]),
+                 "p_cells": patch.pressure[patch.pressure > 0.0],
+                 "r_vertices": np.hypot(s.vertices[loaded, 0], s.vertices[loaded, 1]),
+                 "p_vertices": s.normal_force[0, loaded] / b.area_vectors[loaded, 3]})
+
+
+def mindlin_fretting():
+    """The ball rubbed in partial slip: Cattaneo-Mindlin's force and stick
+    radius, Mindlin and Deresiewicz's energy per cycle."""
+    from meshwear.model import build_model, initial_state
+    from meshwear.simulate import step
+
+    scene = load_scene(VALIDATION / "mindlin_fretting.toml")
+    model = build_model(scene)
+    state = initial_state(model)
+    a, _, _, P = _hertz(scene)
+    c = scene.contact
+    mu, nu, E = c.friction, c.poissons_ratio, c.youngs_modulus
+    compliance = sum(2.0 * (1.0 + n) * (2.0 - n) / e for e, n in zip(E, nu))
+    stroke = scene.bodies[0].path.oscillation.amplitude
+    gross = 3.0 * mu * P * compliance / (16.0 * a)
+    x = 1.0 - (1.0 - stroke / gross) ** 1.5
+    loop = 0.9 * (mu * P) ** 2 * compliance / a * (
+        1.0 - (1.0 - x) ** (5.0 / 3.0) - 5.0 * x / 6.0 * (1.0 + (1.0 - x) ** (2.0 / 3.0)))
+    per_cycle = model.cycle_steps or round(1.0 / (scene.bodies[0].path.oscillation.frequency
+                                                    * model.dt))
+    shift, force, work = [0.0], [0.0], [0.0]
+    stick = None
+    while state.step < model.n_steps:
+        step(model, state)
+        s = state.bodies[0]
+        shift.append(s.elastic.shift)
+        force.append(-s.wrench[0])
+        work.append(float(s.friction_work.sum()))
+        if state.step == per_cycle // 4:            # the first stroke's end
+            patch = s.elastic
+            stick, _ = ellipse_radius(cell_radii(patch), mu * patch.pressure - patch.shear)
+    force, work = np.array(force), np.array(work)
+    second = slice(per_cycle, 2 * per_cycle + 1)
+    case = "Cattaneo-Mindlin ball, half-space"
+    rows = [Row(case, "largest tangential force in the 2nd cycle", x * mu * P,
+                float(force[second].max()), 1e-2, "N"),
+            Row(case, "stick radius at the first stroke's end", a * (1.0 - x) ** (1.0 / 3.0),
+                stick, 2e-2, "m"),
+            Row(case, "friction energy of the 2nd cycle (Mindlin-Deresiewicz)", loop,
+                float(work[2 * per_cycle] - work[per_cycle]), 3e-2, "J")]
+    return Case("mindlin_fretting", VALIDATION / "mindlin_fretting.toml", rows,
+                {"shift": np.array(shift), "force": force, "mu_P": mu * P, "gross": gross,
+                 "stroke": stroke, "x": x})
+
+
 ALL = (winkler_sphere, flat_pin, sphere_pin, tilted_punch, jenkins_quasi_static, pin_on_disc,
-       mesh_independence)
+       mesh_independence, hertz_ball, mindlin_fretting)
 
 
 def arc_chord(u, radius, track):

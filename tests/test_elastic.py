@@ -6,9 +6,12 @@ import numpy as np
 import pytest
 
 from meshwear.halfspace import contact_modulus
+from meshwear.kernels.contact import STICK
 from meshwear.model import build_model, initial_state
 from meshwear.scene import SceneError, load_scene
 from meshwear.simulate import NumericalError, step
+
+from cases import cell_radii, ellipse_radius
 
 E, NU, R, LOAD, MU = 210e9, 0.3, 0.005, 10.0, 0.5
 E_STAR = contact_modulus((E, E), (NU, NU))
@@ -68,45 +71,16 @@ def ball(tmp_path, stroke=0.0, k=0.0, duration=0.1, dt=2.5e-3, motion="guided", 
     return scene.set(extra) if extra else scene
 
 
-def _radius(r2, values):
-    """The radius of an ellipse ``values^2 = c (1 - r^2 / radius^2)``,
-    fitted on the cells where it is positive."""
-    pos = values > 0.0
-    slope, intercept = np.polyfit(r2[pos], values[pos] ** 2, 1)
-    return np.sqrt(-intercept / slope), np.sqrt(intercept)
-
-
-def _cell_r2(patch):
-    h = patch.grid.spacing[0]
-    x = patch.origin[0] + h * np.arange(patch.grid.shape[0])
-    y = patch.origin[1] + h * np.arange(patch.grid.shape[1])
-    X, Y = np.meshgrid(x, y, indexing="ij")
-    return X * X + Y * Y
-
-
-@pytest.fixture(scope="module")
-def pressed(tmp_path_factory):
-    model = build_model(ball(tmp_path_factory.mktemp("hertz"), duration=0.01))
+def test_the_vertices_carry_hertz_pressure(tmp_path):
+    """The load goes back to the vertices whole, each vertex's force over its
+    contact area near Hertz's pressure at it (the closed forms of the
+    grid's pressure are validation rows: tests/cases.py, hertz_ball)."""
+    model = build_model(ball(tmp_path, duration=0.01))
     state = initial_state(model)
-    return model, state
-
-
-def test_hertz_in_a_scene_pressure_radius_and_approach(pressed):
-    model, state = pressed
-    s = state.bodies[0]
-    patch = s.elastic
-    # the vertices carry the load exactly
+    s, b = state.bodies[0], model.bodies[0]
     assert s.normal_force.sum() == pytest.approx(LOAD, rel=1e-12)
     assert s.wrench[2] == pytest.approx(LOAD, rel=1e-12)
-    radius, peak = _radius(_cell_r2(patch), patch.pressure)
-    assert radius == pytest.approx(A, rel=0.01)
-    assert peak == pytest.approx(P0, rel=0.01)
-    assert patch.pressure.max() == pytest.approx(P0, rel=0.015)
-    assert patch.approach - patch.heights.min() == pytest.approx(APPROACH, rel=0.01)
-    # the vertices' pressure (their force over their contact area), Hertz's
-    b = model.bodies[0]
-    x = s.vertices @ np.eye(3)
-    r = np.hypot(x[:, 0], x[:, 1])
+    r = np.hypot(s.vertices[:, 0], s.vertices[:, 1])
     loaded = s.normal_force[0] > 0.0
     inner = loaded & (r < 0.8 * A)
     pressure = s.normal_force[0, inner] / b.area_vectors[inner, 3]
@@ -114,36 +88,10 @@ def test_hertz_in_a_scene_pressure_radius_and_approach(pressed):
     # (each vertex's share of the cells follows its triangles, its area the
     # mesh's barycentric one: a few per cent apart, vertex by vertex)
     assert np.percentile(np.abs(pressure / hertz - 1.0), 90) < 0.05
-    assert np.average(pressure / hertz, weights=b.area_vectors[inner, 3]) == pytest.approx(1.0, abs=0.01)
+    assert np.average(pressure / hertz, weights=b.area_vectors[inner, 3]) == pytest.approx(
+        1.0, abs=0.01)
     assert r[loaded].max() == pytest.approx(A, rel=0.1)
-
-
-def _fretting(scene):
-    model = build_model(scene)
-    state = initial_state(model)
-    force, work = [], []
-    while state.step < model.n_steps:
-        step(model, state)
-        s = state.bodies[0]
-        force.append(-s.wrench[0])
-        work.append(s.friction_work.sum())
-    return model, state, np.array(force), np.array(work)
-
-
-@pytest.mark.parametrize("share", [0.35, 0.7])
-def test_mindlin_in_a_scene_force_and_energy_per_cycle(tmp_path, share):
-    """A ball rubbed by +-stroke below gross slip: the largest tangential
-    force is Mindlin's, Q* = mu P [1 - (1 - stroke / gross)^(3/2)], and the
-    friction work of the second cycle is Mindlin and Deresiewicz's loop."""
-    stroke = share * GROSS
-    model, state, force, work = _fretting(ball(tmp_path, stroke=stroke))
-    x = 1.0 - (1.0 - share) ** 1.5
-    second = force[len(force) // 2:]
-    assert second.max() == pytest.approx(x * MU * LOAD, rel=0.01)
-    assert second.min() == pytest.approx(-x * MU * LOAD, rel=0.01)
-    loop = 0.9 * (MU * LOAD) ** 2 * C_T / A * (
-        1.0 - (1.0 - x) ** (5.0 / 3.0) - 5.0 * x / 6.0 * (1.0 + (1.0 - x) ** (2.0 / 3.0)))
-    assert work[-1] - work[len(work) // 2 - 1] == pytest.approx(loop, rel=0.03)
+    assert np.all(s.contact_state[0, loaded] == STICK)
 
 
 def test_the_stick_zone_at_mindlins_radius_stays_unworn(tmp_path):
@@ -159,7 +107,7 @@ def test_the_stick_zone_at_mindlins_radius_stays_unworn(tmp_path):
         if state.step == 5:                     # a quarter cycle: x = +stroke, first loading
             patch = state.bodies[0].elastic
             reserve = MU * patch.pressure - patch.shear
-            c, _ = _radius(_cell_r2(patch), reserve)
+            c, _ = ellipse_radius(cell_radii(patch), reserve)
     x = 1.0 - (1.0 - share) ** 1.5
     stick = A * (1.0 - x) ** (1.0 / 3.0)
     assert c == pytest.approx(stick, rel=0.03)
@@ -225,3 +173,55 @@ def test_a_conforming_contact_is_refused(tmp_path):
         model = build_model(scene)
         state = initial_state(model)
         step(model, state)
+
+
+def _gaps_twin(vertices, pose, planes, vertex_planes, active, area):
+    """numpy twin of :func:`meshwear.kernels.elastic.gaps`."""
+    from meshwear.surfaces.base import quaternion_matrix
+
+    R = quaternion_matrix(pose[3:7])
+    r = vertices[active] @ R.T
+    x = pose[0:3] + r
+    if len(planes):
+        o, n, v = (np.broadcast_to(planes[0, j], x.shape) for j in range(3))
+        d = np.einsum("ij,ij->i", x - o, n)
+        v = v + np.cross(planes[0, 3], x - d[:, None] * n - planes[0, 0])
+    else:
+        o, n, v = (vertex_planes[0, active, j] for j in range(3))
+        d = np.einsum("ij,ij->i", x - o, n)
+    a = -np.einsum("ij,ij->i", area[active, 0:3] @ R.T, n)
+    facing = (a > 1e-3 * area[active, 3]) & np.any(n != 0.0, axis=1)
+    velocity = pose[7:10] + np.cross(pose[10:13], r) - v
+    return np.where(facing, d, np.inf), n, a, r, velocity
+
+
+@pytest.mark.parametrize("kind", ["plane", "per-vertex"])
+def test_the_gaps_kernel_matches_its_numpy_twin(kind):
+    from meshwear.kernels.elastic import gaps
+
+    rng = np.random.default_rng(3)
+    n = 50
+    vertices = rng.normal(size=(n, 3))
+    area = np.column_stack([rng.normal(size=(n, 3)), np.zeros(n)])
+    area[:, 3] = np.linalg.norm(area[:, 0:3], axis=1)
+    q = rng.normal(size=4)
+    pose = np.concatenate([rng.normal(size=3), q / np.linalg.norm(q), rng.normal(size=6)])
+    if kind == "plane":
+        normal = rng.normal(size=3)
+        planes = np.array([rng.normal(size=3), normal / np.linalg.norm(normal),
+                           rng.normal(size=3), 0.3 * normal / np.linalg.norm(normal)])[None]
+        vertex_planes = np.zeros((0, n, 3, 3))
+    else:
+        planes = np.zeros((0, 4, 3))
+        normals = rng.normal(size=(n, 3))
+        normals /= np.linalg.norm(normals, axis=1)[:, None]
+        normals[::7] = 0.0                                # no face within reach
+        vertex_planes = np.stack([rng.normal(size=(n, 3)), normals, rng.normal(size=(n, 3))],
+                                 axis=1)[None]
+    active = np.array(sorted(rng.choice(n, 30, replace=False)), dtype=np.int64)
+    out = [np.empty(30), np.empty((30, 3)), np.empty(30), np.empty((30, 3)), np.empty((30, 3))]
+    gaps(vertices, pose, planes, vertex_planes, active, area, *out)
+    twin = _gaps_twin(vertices, pose, planes, vertex_planes, active, area)
+    assert np.isinf(out[0]).any() and np.isfinite(out[0]).any()
+    for got, want in zip(out, twin):
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
