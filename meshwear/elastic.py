@@ -606,3 +606,32 @@ def describe(model, state):
                 "the patch is not small against the radii of curvature (the half-space "
                 "assumption); model = 'winkler' may suit a conforming contact better")
     return lines, warnings
+
+
+def equivalent_depth(model, body, s, index, depth, area):
+    """The penetrations a cycle jump reasons with (:func:`meshwear.jumps.contact_geometry`)
+    for a half-space contact: a loaded vertex's force over its stiffness on
+    the equivalent Winkler foundation, ``N_i / (K A_i)``; an unloaded one in
+    the patch, minus its gap after the surfaces deformed (the rigid overlap
+    of a vertex just outside an elastic contact, out to sqrt(2) a on a
+    ball, carries nothing: taken as a penetration it would carry load and
+    wear in the jump); the others' rigid ``depth`` as given."""
+    patch = s.elastic
+    if patch is None or patch.pressure is None or patch.index is None:
+        return depth
+    pos = np.minimum(np.searchsorted(patch.index, index), len(patch.index) - 1)
+    ours = patch.index[pos] == index
+    # the surfaces' displacement at each vertex: its nearest cell's
+    u = patch.grid.convolve(patch.pressure)
+    cell = np.rint((patch.coords[pos[ours]] - patch.origin) / patch.grid.spacing[0]).astype(int)
+    cell = np.clip(cell, 0, np.array(u.shape) - 1)
+    displacement = np.zeros(len(index))
+    displacement[ours] = u[cell[:, 0], cell[:, 1]]
+    force = s.normal_force[0, index]
+    stiffness = model.law[5] + model.law[6] * area
+    out = depth.copy()
+    loaded = ours & (force > 0.0) & (stiffness > 0.0)
+    out[loaded] = force[loaded] / stiffness[loaded]
+    free = ours & ~loaded & np.isfinite(depth)
+    out[free] = np.minimum(depth[free] - displacement[free], 0.0)
+    return out

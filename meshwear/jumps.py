@@ -41,6 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .elastic import equivalent_depth
 from .kernels.balance import solve
 from .kernels.contact import FACING
 from .motion import BalancedMotion, GuidedMotion, MechanismMotion
@@ -71,6 +72,8 @@ def contact_geometry(model, body, s, index):
         d = -np.einsum("ij,ij->i", x - point, nrm)
         better = facing & (d > depth)
         depth[better], normal[better], area[better] = d[better], nrm[better], projected[better]
+    if model.elastic is not None:
+        depth = equivalent_depth(model, body, s, index, depth, area)
     return depth, normal, model.law[5] + model.law[6] * area
 
 
