@@ -72,6 +72,9 @@ BAND_USE = 0.7
 #: ... and a patch is built again when the approach passes this fraction of
 #: its band, or falls below the next
 GROW_BAND, SHRINK_BAND = 0.9, 0.3
+#: a slip velocity the same at every loaded vertex and along the grid's first
+#: axis to this fraction of its speed is a translation: Cattaneo-Mindlin
+UNIFORM = 1e-3
 #: tangential solves kept for a periodic stroke to repeat
 CACHE_STEPS = 1024
 #: two turning points whose shears differ by less than this fraction of the
@@ -136,6 +139,7 @@ class Patch:
     loaded: np.ndarray = None            # the patch's vertices that carry load ...
     transposed_loaded: object = None     # ... and their rows of transposed
     written: np.ndarray = None           # the vertices the last step gave a contact
+    counter: tuple = None                # (vertices, force): what a worn counter wears by
     window: tuple = None                 # the cells the tangential problem is solved on
     shear_grid: object = None            # the grid of that window
     sliding: bool = False
@@ -390,6 +394,11 @@ def step(model, body, s, t, before, at_rest=False):
         s.wear_depth[idx[worn]] += dw[worn]
         s.wear_volume[idx[worn]] += dv[worn]
     s.friction_work[idx] += energy
+    # what a worn counter wears by: each vertex's energy as a slip at its
+    # speed (the counter's kernel dissipates f N |v| dt in slip)
+    speed = np.linalg.norm(slip_v, axis=1)
+    moving = (energy > 0.0) & (speed > 0.0) & (mu > 0.0)
+    patch.counter = (idx[moving], energy[moving] / (mu * speed[moving] * model.dt))
     s.normal_force[0, idx] = F
     s.tangential[0, idx, FORCE_SLOT] = friction
     s.contact_state[0, idx] = state
@@ -413,6 +422,20 @@ def step(model, body, s, t, before, at_rest=False):
             patch.extra["foundation"] = True
 
 
+def counter_pairs(s):
+    """Per slot, the (contact state, normal force) a worn counter-surface
+    wears by after a half-space step (:func:`meshwear.model.wear_counters`):
+    the vertices that dissipated energy slip, each with the force whose
+    Coulomb slip at its speed dissipates that energy; the others nothing."""
+    patch = s.elastic
+    state, force = np.zeros_like(s.contact_state), np.zeros_like(s.normal_force)
+    if patch is not None and patch.counter is not None:
+        idx, f = patch.counter
+        state[0, idx] = SLIP
+        force[0, idx] = f
+    return list(zip(state, force))
+
+
 def _tangential(model, patch, F, slip_v, mu, at_rest):
     """Friction energy (J), force (k, 3, N, on the body) and contact state
     of the patch's loaded vertices (their forces ``F``, slip velocities
@@ -427,8 +450,10 @@ def _tangential(model, patch, F, slip_v, mu, at_rest):
         return np.zeros(len(F)), friction, state
     mean_v = slip_v.mean(axis=0)
     speed = float(np.linalg.norm(mean_v))
-    uniform = np.abs(slip_v - mean_v).max() <= 1e-9 * speed + 1e-300
-    along = abs(mean_v @ patch.e2) <= 1e-9 * speed + 1e-300
+    # (within UNIFORM of the speed: a worn counter's faces tilt by its wear
+    # slopes, and the slip in each one's plane differs by as much)
+    uniform = np.abs(slip_v - mean_v).max() <= UNIFORM * speed + 1e-300
+    along = abs(mean_v @ patch.e2) <= UNIFORM * speed + 1e-300
     area_cell = patch.grid.cell_area
     if not (uniform and along and mu > 0.0):
         # sliding: Coulomb at every vertex against its own slip velocity

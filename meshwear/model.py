@@ -752,17 +752,22 @@ def body_contact(model, body, s, law=None):
             s.wrench)
 
 
-def wear_counters(model, body, s, t):
+def wear_counters(model, body, s, t, pairs=None):
     """The wear of the worn counter-surfaces by the step of ``body`` just
     taken at ``t`` (:func:`meshwear.kernels.counter_wear.wear_counter`).
-    Returns None, or ``(surface, vertex)``: a counter vertex that sank
-    deeper than its mesh can follow in that step."""
+    ``pairs``: per slot, the (contact state, normal force) the counter
+    wears by, in place of the body's (the half-space model's: each vertex's
+    energy as a slip of its speed, :mod:`meshwear.elastic`). Returns None,
+    or ``(surface, vertex)``: a counter vertex that sank deeper than its
+    mesh can follow in that step."""
     P = model.planes.shape[0]
     for m, surface in enumerate(model.surfaces.per_vertex):
         if surface.worn:
             rotation, frame = surface.frame(t)
+            state, force = (s.contact_state[P + m], s.normal_force[P + m]) if pairs is None \
+                else pairs[P + m]
             worst = wear_counter(s.vertices, s.pose, s.active, body.area_vectors, model.law,
-                                 s.contact_state[P + m], s.normal_force[P + m],
+                                 state, force,
                                  s.vertex_planes[m], s.hint[m], rotation, frame,
                                  surface.part_tuple())
             if worst >= 0:

@@ -89,7 +89,7 @@ def _quasi_static_step(model, body, s, k):
             # for the next step
             surfaces.update(model, body, s, t)
         if model.worn_counters:
-            too_deep = wear_counters(model, body, s, t)
+            too_deep = wear_counters(model, body, s, t, elastic.counter_pairs(s))
             if too_deep is not None:
                 raise counter_too_deep(model, *too_deep, t)
         return

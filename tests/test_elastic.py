@@ -249,3 +249,38 @@ def test_cycle_jumps_wear_a_fretting_ball_as_its_resolved_cycles():
     resolved, jumped = depths["none"], depths["cycle_jump"]
     assert jumped.max() == pytest.approx(resolved.max(), rel=0.02)
     assert jumped.sum() == pytest.approx(resolved.sum(), rel=0.02)
+
+
+def test_a_worn_mesh_flat_wears_by_the_same_energy(tmp_path):
+    """The ball fretting on a worn mesh flat, half-space contact: the flat's
+    gap under each vertex is its face's, and it dissipates and wears by the
+    ball's energy, vertex by vertex: with the same coefficient, the same
+    volume, k times the friction work."""
+    text = (Path(__file__).resolve().parents[1] / "examples" / "validation"
+            / "hertz_ball.toml").read_text()
+    text = text[:text.index("[[surface]]")] + """[[surface]]
+name = "flat"
+type = "mesh"
+shape = { type = "box", size = [0.001, 0.001, 0.0005] }
+resolution = 1e-5
+position = [0.0, 0.0, -0.00025]
+wear = true
+coefficient = 1e-12
+"""
+    text = text.replace("coefficient = 0.0", 'law = "energy_density"\ncoefficient = 1e-12')
+    text = text.replace("duration = 0.01", "duration = 0.1").replace("dt = 0.01", "dt = 6.25e-3")
+    text = text.replace("[body.path]\n", "[body.path]\noscillation = { axis = [1.0, 0.0, 0.0], "
+                        "amplitude = 3e-6, frequency = 20.0 }\n")
+    path = tmp_path / "mesh_flat.toml"
+    path.write_text(text)
+    from meshwear.simulate import run
+
+    model = build_model(load_scene(path))
+    state = run(model, initial_state(model))
+    s, part = state.bodies[0], state.parts[0]
+    work = s.friction_work.sum()
+    assert 0.5 * MU * LOAD * 8 * 3e-6 < work < MU * LOAD * 8 * 3e-6     # partial slip at the turns
+    assert s.normal_force.sum() == pytest.approx(LOAD, rel=1e-9)
+    assert part.work.sum() == pytest.approx(work, rel=1e-9)
+    assert part.volume.sum() == pytest.approx(1e-12 * work, rel=1e-9)
+    assert s.wear_volume.sum() == pytest.approx(1e-12 * work, rel=1e-9)
