@@ -513,9 +513,17 @@ def _tangential(model, patch, F, slip_v, mu, at_rest):
             patch.turn = np.clip(patch.turn, -limit, limit)
             # on the cells around the contact only (the shear is zero elsewhere)
             win, grid = patch.window, patch.shear_grid
+            start = patch.reserve
+            last = patch.extra.get("last_reserve")
+            if start is not None and last is not None and last[0].shape == start.shape:
+                # the reserve moves on smoothly along a branch: extrapolated
+                # from the last two steps, the solve starts nearer its answer
+                start = np.maximum(start + (start - last[0]) * (move / last[1]), 0.0)
             q_win, stick_win, w = halfspace.shear_at_shift(
                 grid, patch.pressure[win], mu, patch.shift, patch.turn[win], patch.turn_shift,
-                start=patch.reserve, tol=SHEAR_TOLERANCE)
+                start=start, tol=SHEAR_TOLERANCE)
+            patch.extra["last_reserve"] = (patch.reserve, move) if patch.reserve is not None \
+                else None
             patch.reserve = w
             # each cell's slip: the stroke less the surfaces' elastic stretch
             # (a slipping cell's shear is its limit, mu p, all the step)

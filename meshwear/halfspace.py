@@ -6,8 +6,9 @@ surfaces is the pressure convolved with Boussinesq's influence function, the
 tangential one the shear convolved with Cerruti's. On a regular grid of
 cells (uniform traction over each), the influence coefficients are Love's
 closed forms for a rectangle, the convolution is a discrete convolution that
-the FFT evaluates without wrap-around error on a grid padded to twice the
-size (DC-FFT: Liu, Wang and Liu, Wear 243 (2000) 101-111), and the contact
+the FFT evaluates without wrap-around error on a grid padded to at least
+2 n - 1 cells a side, the next size the FFT is fast at (DC-FFT: Liu, Wang
+and Liu, Wear 243 (2000) 101-111), and the contact
 conditions are solved by the constrained conjugate gradient of Polonsky and
 Keer (Wear 231 (1999) 206-219): pressure ``p >= 0``, gap ``g >= 0``,
 ``p g = 0`` and the total load given.
@@ -74,6 +75,9 @@ class Grid:
     spacing: tuple
     normal: np.ndarray           # rfftn of the normal kernel (m/Pa)
     shear: np.ndarray            # rfftn of the tangential (x) kernel (m/Pa), or None
+    #: the padded grid the FFT runs on: per axis at least 2 n - 1 cells, the
+    #: next size the FFT is fast at (scipy.fft.next_fast_len)
+    padded: tuple = None
 
     @property
     def cell_area(self):
@@ -89,7 +93,7 @@ class Grid:
         """The displacement (m) the ``traction`` (Pa) on the cells causes at
         each cell's centre, by the ``normal`` (Boussinesq) or ``shear``
         (Cerruti, along x) kernel."""
-        padded = tuple(2 * n for n in self.shape)
+        padded = self.padded
         k = self.normal if kernel == "normal" else self.shear
         out = fft.irfftn(k * fft.rfftn(traction, padded), padded)
         return out[tuple(slice(0, n) for n in self.shape)]
@@ -101,24 +105,25 @@ def make_grid(shape, spacing, youngs, poisson):
     Poisson's ratios ``poisson`` (pairs)."""
     shape = tuple(int(n) for n in np.atleast_1d(shape))
     spacing = tuple(float(h) for h in np.broadcast_to(spacing, (len(shape),)))
-    # the kernel on the padded grid in wrap-around order: offsets 0 .. n-1,
-    # then -n .. -1 (offset n multiplies the padding only)
+    padded = tuple(fft.next_fast_len(2 * n - 1, real=True) for n in shape)
+    # the kernel on the padded grid in wrap-around order: offsets 0 .. n-1
+    # first, -(n-1) .. -1 last (those between multiply the padding only)
     offsets = []
-    for n, h in zip(shape, spacing):
-        i = np.arange(2 * n)
-        d = np.where(i < n, i, i - 2 * n).astype(float) * h
+    for n, h, m in zip(shape, spacing, padded):
+        i = np.arange(m)
+        d = np.where(i < n, i, i - m).astype(float) * h
         offsets.append(d)
     normal_compliance = sum((1.0 - nu * nu) / e for e, nu in zip(youngs, poisson))
     if len(shape) == 1:
         # plane strain: u = -(2 / (pi E*)) integral p ln|x - s| ds + const
         k = 2.0 * normal_compliance / np.pi * _strip_integral(offsets[0], 0.5 * spacing[0])
-        return Grid(shape, spacing, fft.rfftn(k), None)
+        return Grid(shape, spacing, fft.rfftn(k), None, padded)
     x, y = np.meshgrid(offsets[0], offsets[1], indexing="ij")
     hx, hy = 0.5 * spacing[0], 0.5 * spacing[1]
     k = normal_compliance / np.pi * _cell_integral(x, y, hx, hy)
     shear = sum(1.0 / (2.0 * np.pi * e / (2.0 * (1.0 + nu)))
                 * _cell_integral(x, y, hx, hy, shear_nu=nu) for e, nu in zip(youngs, poisson))
-    return Grid(shape, spacing, fft.rfftn(k), fft.rfftn(shear))
+    return Grid(shape, spacing, fft.rfftn(k), fft.rfftn(shear), padded)
 
 
 @dataclass
