@@ -253,10 +253,13 @@ def _locate(patch, active, r):
             return None
         patch.where = where
         patch.outside = np.setdiff1d(np.arange(len(active)), where, assume_unique=True)
-    rw = r[where]
-    drift = max(np.abs(rw @ patch.e1 - patch.coords[:, 0]).max(),
-                np.abs(rw @ patch.e2 - patch.coords[:, 1]).max())
-    return where if drift <= 1e-6 * patch.grid.spacing[0] else None
+    # the loaded vertices' drift in the tangent plane (a turning body, wear
+    # along the vertex normals) against a thousandth of a cell
+    on = patch.loaded if patch.loaded is not None else slice(None)
+    rw = r[where[on]]
+    drift = max(np.abs(rw @ patch.e1 - patch.coords[on, 0]).max(initial=0.0),
+                np.abs(rw @ patch.e2 - patch.coords[on, 1]).max(initial=0.0))
+    return where if drift <= 1e-3 * patch.grid.spacing[0] else None
 
 
 def step(model, body, s, t, before, at_rest=False):
