@@ -44,9 +44,9 @@ from scipy import sparse
 from scipy.spatial import Delaunay, QhullError
 
 from . import halfspace
+from .kernels.contact import FORCE as FORCE_SLOT
 from .kernels.contact import NO_CONTACT, SLIP, STICK
 from .kernels.elastic import gaps
-from .kernels.contact import FORCE as FORCE_SLOT
 from .kernels.laws import LAWS, name_of
 from .kernels.rigid import OSCILLATION, STEADY
 from .motion import BalancedMotion
@@ -60,7 +60,8 @@ RESOLVE = 1e-3
 TOLERANCE = 1e-8
 #: ... and the tangential one, taken at every step of a partial slip from
 #: the last step's (Mindlin's force and Mindlin-Deresiewicz's energy agree
-#: to 1e-4 and 0.3 % at this and at 1e-8 alike: tests/test_elastic.py)
+#: to 1e-4 and 0.3 % at this and at 1e-8 alike: the validation case
+#: mindlin_fretting, tests/cases.py)
 SHEAR_TOLERANCE = 1e-4
 #: the band of gaps the first patch spans, in vertices of smallest gap
 FIRST_BAND_VERTICES = 64

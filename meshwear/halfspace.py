@@ -200,7 +200,6 @@ def solve(grid, gap, load, mask=None, kernel="normal", start=None, tol=1e-10,
 def _solve_approach(grid, h, approach, allowed, kernel, start, tol, max_iterations):
     """:func:`solve` at a given ``approach``: the same conjugate gradient
     without the load's constraint (no mean removed, no rescaling)."""
-    area = grid.cell_area
     if start is not None and np.any(start[allowed] > 0.0):
         p = np.where(allowed, np.maximum(start, 0.0), 0.0)
     else:
