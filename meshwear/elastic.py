@@ -23,9 +23,11 @@ a spring per vertex. At each step, for each body and its counter-surface:
 4. Tangential. A translation along the grid's first axis, the same at
    every point (a fretting stroke, a straight slide), is Cattaneo-Mindlin
    partial slip with Mindlin and Deresiewicz's reversals, solved at the
-   stroke's displacement (:func:`meshwear.halfspace.shear_at_shift`): stick
-   and slip per cell, each cell's slip and friction energy from its shear
-   and the relative displacement of the surfaces. Any other relative
+   stroke's displacement (:func:`meshwear.halfspace.shear_at_shift`) on the
+   window of pressed cells (merged f x f where wider than
+   :data:`SHEAR_CELLS`): stick and slip per cell, each cell's slip and
+   friction energy from its shear and the relative displacement of the
+   surfaces. Any other relative
    motion (a turning disc, a circle) slides: Coulomb at every vertex,
    ``mu N_i`` against its slip velocity.
 5. Wear. Each vertex's energy (the cells' by the same transposed weights),
@@ -76,6 +78,9 @@ GROW_BAND, SHRINK_BAND = 0.9, 0.3
 #: a slip velocity the same at every loaded vertex and along the grid's first
 #: axis to this fraction of its speed is a translation: Cattaneo-Mindlin
 UNIFORM = 1e-3
+#: the tangential problem is solved on at most about this many cells a side:
+#: a wider window merges its cells f x f (the normal one keeps them all)
+SHEAR_CELLS = 64
 #: tangential solves kept for a periodic stroke to repeat
 CACHE_STEPS = 1024
 #: two turning points whose shears differ by less than this fraction of the
@@ -142,7 +147,8 @@ class Patch:
     written: np.ndarray = None           # the vertices the last step gave a contact
     counter: tuple = None                # (vertices, force): what a worn counter wears by
     window: tuple = None                 # the cells the tangential problem is solved on
-    shear_grid: object = None            # the grid of that window
+    shear_grid: object = None            # the grid of that window ...
+    shear_factor: int = 1                # ... its cells f x f of the patch's
     sliding: bool = False
     # the tangential solves of this pressure, by the step they took (a
     # periodic stroke repeats them)
@@ -515,30 +521,37 @@ def _tangential(model, patch, F, slip_v, mu, at_rest):
             cell_energy = limit * abs(move) * area_cell
         else:
             patch.turn = np.clip(patch.turn, -limit, limit)
-            # on the cells around the contact only (the shear is zero elsewhere)
-            win, grid = patch.window, patch.shear_grid
+            # on the cells around the contact only (the shear is zero
+            # elsewhere), merged f x f where the window is wide
+            win, grid, f = patch.window, patch.shear_grid, patch.shear_factor
+            p_win = patch.pressure[win]
+            p_c = _merge(p_win, f)
             start = patch.reserve
             last = patch.extra.get("last_reserve")
             if start is not None and last is not None and last[0].shape == start.shape:
                 # the reserve moves on smoothly along a branch: extrapolated
                 # from the last two steps, the solve starts nearer its answer
                 start = np.maximum(start + (start - last[0]) * (move / last[1]), 0.0)
-            q_win, stick_win, w = halfspace.shear_at_shift(
-                grid, patch.pressure[win], mu, patch.shift, patch.turn[win], patch.turn_shift,
+            q_c, stick_c, w = halfspace.shear_at_shift(
+                grid, p_c, mu, patch.shift, _merge(patch.turn[win], f), patch.turn_shift,
                 start=start, tol=SHEAR_TOLERANCE)
             patch.extra["last_reserve"] = (patch.reserve, move) if patch.reserve is not None \
                 else None
             patch.reserve = w
             # each cell's slip: the stroke less the surfaces' elastic stretch
             # (a slipping cell's shear is its limit, mu p, all the step)
-            slip = move - grid.convolve(q_win - np.clip(q_old, -limit, limit)[win], "shear")
+            q_old_c = _merge(np.clip(q_old, -limit, limit)[win], f)
+            slip = move - grid.convolve(q_c - q_old_c, "shear")
+            energy_c = np.where(stick_c, 0.0, np.maximum(q_c * slip, 0.0)) * grid.cell_area
+            # back to the cells, in proportion to their pressure (f = 1: as is)
+            q_win, stick_win = _split(q_c, p_c, p_win, f), _spread_cells(stick_c, f) & (p_win > 0.0)
             q = np.zeros(limit.shape)
             q[win] = q_win
             stick = np.zeros(q.shape, bool)
             stick[win] = stick_win
             cell_energy = np.zeros(limit.shape)
-            cell_energy[win] = np.where(stick_win, 0.0, np.maximum(q_win * slip, 0.0)) * area_cell
-            patch.gross = not stick_win.any()
+            cell_energy[win] = _split(energy_c / (f * f), p_c, p_win, f)
+            patch.gross = not stick_c.any()
             patch.gross_pressure = patch.pressure
         if hit is None:
             new_key = (patch.turn_key, round(patch.shift * 1e15))
@@ -592,6 +605,47 @@ def _regrid(values, patch, old):
     return out
 
 
+def _merge(values, f):
+    """The means of ``values`` (a window) over blocks of f x f cells."""
+    if f == 1:
+        return values
+    a, b = values.shape
+    return values.reshape(a // f, f, b // f, f).mean(axis=(1, 3))
+
+
+def _spread_cells(values, f):
+    """Each block's value on its f x f cells."""
+    return values if f == 1 else np.repeat(np.repeat(values, f, axis=0), f, axis=1)
+
+
+def _split(block, pressure_block, pressure, f):
+    """A block's mean (a shear, an energy per cell) given to its cells in
+    proportion to their pressure: the block's mean kept (``pressure_block``
+    is the mean of ``pressure`` over it), a cell's shear within mu times its
+    own pressure."""
+    if f == 1:
+        return block
+    share = np.where(pressure_block > 0.0, block / np.where(pressure_block > 0.0,
+                                                             pressure_block, 1.0), 0.0)
+    return _spread_cells(share, f) * pressure
+
+
+def _window(lo, hi, size, f):
+    """Per axis, the window [lo, hi) widened to a multiple of f cells within
+    the grid's ``size`` cells (f = 1 where the grid is too small)."""
+    out, factors = [], []
+    for a, b, n in zip(lo, hi, size):
+        extent = -(-(b - a) // f) * f
+        if extent > n:
+            extent, factor = b - a, 1
+        else:
+            factor = f
+        b2 = min(a + extent, n)
+        out.append(slice(int(b2 - extent), int(b2)))
+        factors.append(factor)
+    return tuple(out), min(factors)
+
+
 def _new_pressure(patch, solution, heights):
     patch.pressure = solution.traction
     patch.heights = heights.copy()
@@ -603,16 +657,20 @@ def _new_pressure(patch, solution, heights):
     pressed = np.argwhere(solution.traction > 0.0)
     if len(pressed):
         lo, hi = pressed.min(axis=0), pressed.max(axis=0) + 1
-        window = tuple(slice(a, b) for a, b in zip(lo, hi))
-        shape = tuple(int(b - a) for a, b in zip(lo, hi))
-        key = (shape, patch.grid.spacing)
+        f = max(1, -(-int((hi - lo).max()) // SHEAR_CELLS))
+        window, f = _window(lo, hi, solution.traction.shape, f)
+        if f > 1 and any((w.stop - w.start) % f for w in window):
+            window, f = _window(lo, hi, solution.traction.shape, 1)
+        shape = tuple((w.stop - w.start) // f for w in window)
+        key = (shape, patch.grid.spacing, f)
         if patch.extra.get("shear_key") != key:
             patch.extra["shear_key"] = key
-            patch.shear_grid = halfspace.make_grid(shape, patch.grid.spacing,
-                                                   patch.extra["youngs"], patch.extra["poisson"])
-        if window != patch.window:
+            patch.shear_grid = halfspace.make_grid(
+                shape, tuple(f * h for h in patch.grid.spacing), patch.extra["youngs"],
+                patch.extra["poisson"])
+        if window != patch.window or f != patch.shear_factor:
             patch.reserve = None
-        patch.window = window
+        patch.window, patch.shear_factor = window, f
 
 
 def describe(model, state):

@@ -404,8 +404,63 @@ def mindlin_fretting():
                  "stroke": stroke, "x": x})
 
 
+def halfspace_grid():
+    """The half-space solver on its grid (meshwear/halfspace.py), steel on
+    steel: Hertz's cylinder, the rigid flat punch, Cattaneo-Mindlin's stick
+    radius and Mindlin-Deresiewicz's energy at three tangential loads (the
+    sphere's Hertz rows are the hertz_ball case's, on a mesh)."""
+    from meshwear.halfspace import contact_modulus, make_grid, solve, solve_shear
+
+    E, nu, R, P, mu = 210e9, 0.3, 0.01, 10.0, 0.5
+    e_star = contact_modulus((E, E), (nu, nu))
+    compliance = 2.0 * 2.0 * (1.0 + nu) * (2.0 - nu) / E
+    case, rows = "half-space grid", []
+    # a cylinder, plane strain, 1e5 N/m on 128 cells
+    load = 1e5
+    half = np.sqrt(4.0 * load * R / (np.pi * e_star))
+    grid = make_grid((128,), 3.0 * half / 128, (E, E), (nu, nu))
+    x = grid.centres[0]
+    p = solve(grid, x * x / (2.0 * R), load).traction
+    width, _ = ellipse_radius(x * x, p)
+    rows += [Row(case, "Hertz cylinder: half-width b = sqrt(4PR / pi E*)", half, width, 1e-2, "m"),
+             Row(case, "Hertz cylinder: peak pressure 2P / pi b", 2.0 * load / (np.pi * half),
+                 float(p.max()), 1e-2, "Pa")]
+    # a rigid flat punch, radius 1 mm, 100 N on 128 x 128 cells
+    radius, load = 1e-3, 100.0
+    grid = make_grid((128, 128), 2.4 * radius / 128, (E, E), (nu, nu))
+    x, y = np.meshgrid(*grid.centres, indexing="ij")
+    punch = solve(grid, np.zeros((128, 128)), load, mask=x * x + y * y <= radius * radius)
+    rows.append(Row(case, "flat punch: load against 2 a E* delta", 2.0 * radius * e_star
+                    * punch.approach, load, 1e-2, "N"))
+    # a sphere, 10 N on 64 x 64 cells over three contact radii, then shear
+    a = (3.0 * P * R / (4.0 * e_star)) ** (1.0 / 3.0)
+    grid = make_grid((64, 64), 3.0 * a / 64, (E, E), (nu, nu))
+    x, y = np.meshgrid(*grid.centres, indexing="ij")
+    r2 = x * x + y * y
+    p = solve(grid, r2 / (2.0 * R), P).traction
+    for share in (0.3, 0.6, 0.9):
+        q, _, _ = solve_shear(grid, p, mu, share * mu * P)
+        stick, _ = ellipse_radius(r2, mu * p - q)
+        rows.append(Row(case, f"Cattaneo-Mindlin stick radius at Q = {share} mu P",
+                        a * (1.0 - share) ** (1.0 / 3.0), stick, 2e-2, "m"))
+    for share in (0.3, 0.6, 0.9):
+        top = share * mu * P
+        q_top, _, s_top = solve_shear(grid, p, mu, top)
+        q_bottom, _, s_bottom = solve_shear(grid, p, mu, -top, q_top, top, s_top)
+        forces = np.linspace(top, -top, 41)
+        down = [solve_shear(grid, p, mu, f, q_top, top, s_top)[2] for f in forces]
+        up = [solve_shear(grid, p, mu, f, q_bottom, -top, s_bottom)[2] for f in forces[::-1]]
+        loop = float(np.trapezoid(np.array(down) - np.array(up)[::-1], -forces))
+        expected = 0.9 * (mu * P) ** 2 * compliance / a * (
+            1.0 - (1.0 - share) ** (5.0 / 3.0)
+            - 5.0 * share / 6.0 * (1.0 + (1.0 - share) ** (2.0 / 3.0)))
+        rows.append(Row(case, f"Mindlin-Deresiewicz energy per cycle at Q* = {share} mu P",
+                        expected, loop, 3e-2, "J"))
+    return Case("halfspace_grid", Path(__file__).resolve().parent / "test_halfspace.py", rows)
+
+
 ALL = (winkler_sphere, flat_pin, sphere_pin, tilted_punch, jenkins_quasi_static, pin_on_disc,
-       mesh_independence, hertz_ball, mindlin_fretting)
+       mesh_independence, hertz_ball, mindlin_fretting, halfspace_grid)
 
 
 def arc_chord(u, radius, track):
