@@ -84,14 +84,14 @@ def _quasi_static_step(model, body, s, k):
             elastic.step(model, body, s, t, before)
         except elastic.PatchError as err:
             raise NumericalError(str(err)) from None
-        if surfaces.moved_since_refresh(model, body, s, t) >= s.cull[surfaces.CULL_MARGIN]:
-            # the balance moved it beyond its active set's bound: refresh it
-            # for the next step
-            surfaces.update(model, body, s, t)
         if model.worn_counters:
             too_deep = wear_counters(model, body, s, t, elastic.counter_pairs(s))
             if too_deep is not None:
                 raise counter_too_deep(model, *too_deep, t)
+        if surfaces.moved_since_refresh(model, body, s, t) >= s.cull[surfaces.CULL_MARGIN]:
+            # the balance moved it beyond its active set's bound: refresh it
+            # for the next step
+            surfaces.update(model, body, s, t)
         return
     settle = getattr(body.motion, "settle", None)
     if settle is not None:
