@@ -15,7 +15,7 @@ peak pressure and deepest wear, and writes the figure
 docs/img/elastic_vs_winkler.png (contact radius, peak pressure and deepest
 wear against the sliding distance, and the pressure across the contact at
 the start and at the end) and the measured section of
-docs/examples/elastic_vs_winkler.md. About four minutes here.
+docs/examples/elastic_vs_winkler.md. About two minutes here.
 
     .venv/bin/python benchmarks/elastic_vs_winkler.py [--no-write]
 """
