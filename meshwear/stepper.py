@@ -64,10 +64,11 @@ def _advance_bodies(model, state, start, until):
     surfaces = model.surfaces
     planes = surfaces.compiled_planes()
     report = np.zeros(2, np.int64)
+    advance_body = loop.loop_for(model)
     for body, s in zip(model.bodies, state.bodies):
         k = start
         while k < until:
-            k, what = loop.advance_body(k, until, dt, model.quasi_static, model.cull,
+            k, what = advance_body(k, until, dt, model.quasi_static, model.cull,
                                         _body_arrays(model, body, s),
                                         _motion_arrays(model, body, s), planes,
                                         surfaces.compiled_list(), surfaces.bounds,

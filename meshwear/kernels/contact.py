@@ -421,15 +421,21 @@ def _named_copy(fn, name, **constants):
 _FLAGS = {"contract"}
 
 
+#: each kernel's builds by name: general, one plane, one surface
+BUILDS = {}
+
+
 def _build(name, parallel):
     """``name``: the kernel, serial or threaded, dispatching to its general
     build or to the ones compiled for one analytic plane and no per-vertex
-    surface, and for one per-vertex surface and no plane."""
+    surface, and for one per-vertex surface and no plane (also in
+    :data:`BUILDS`, for a caller that knows its case and compiles only it)."""
     options = dict(cache=True, fastmath=_FLAGS, error_model="numpy", parallel=parallel)
     general = njit(**options)(_named_copy(_contact, name + "_general"))
     one_plane = njit(**options)(_named_copy(_contact, name + "_one_plane", ONE_PLANE=True))
     one_surface = njit(**options)(_named_copy(_contact, name + "_one_surface",
                                               ONE_SURFACE=True))
+    BUILDS[name] = (general, one_plane, one_surface)
     return njit(cache=True)(_named_copy(_dispatch, name, GENERAL_BUILD=general,
                                         ONE_PLANE_BUILD=one_plane,
                                         ONE_SURFACE_BUILD=one_surface))
@@ -449,7 +455,16 @@ def contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear_
     number of vertex-surface pairs makes threads worth starting.
     """
     slots = planes.shape[0] + vertex_planes.shape[0]
-    kernel = contact_parallel if active.shape[0] * slots >= PARALLEL_THRESHOLD else contact_serial
+    name = "contact_parallel" if active.shape[0] * slots >= PARALLEL_THRESHOLD else "contact_serial"
+    # the build for the case, picked here as _dispatch picks it in a compiled
+    # caller (so that a first run compiles only the build it uses)
+    general, one_plane, one_surface = BUILDS[name]
+    if planes.shape[0] == 1 and vertex_planes.shape[0] == 0:
+        kernel = one_plane
+    elif planes.shape[0] == 0 and vertex_planes.shape[0] == 1:
+        kernel = one_surface
+    else:
+        kernel = general
     kernel(body_vertices, pose, planes, vertex_planes, active, area, law, wear_direction,
            contact_state, tangential, normal_force, friction_work, wear_depth, wear_volume, wrench)
 

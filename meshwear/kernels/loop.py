@@ -42,8 +42,8 @@ import numpy as np
 from numba import njit
 
 from .balance import balance_offset
-from .contact import (PARALLEL_THRESHOLD, contact_parallel, contact_serial, plane_under,
-                      rotation_entries)
+from .contact import (BUILDS, PARALLEL_THRESHOLD, _named_copy, contact_parallel, contact_serial,
+                      plane_under, rotation_entries)
 from .counter import fill_planes
 from .counter_wear import wear_counter
 from .frames import moved_since_refresh, plane_rows, step_motion, surface_frame
@@ -53,7 +53,17 @@ from .rigid import AXIS, BALANCED, CARRIED, advance_motion, place_motion
 DONE, REFRESH, FINISH, NO_BALANCE, TOO_DEEP, IMPACT = 0, 1, 2, 3, 4, 5
 
 
-@njit(cache=True)
+# The loop is compiled in two builds from the one definition (as the contact
+# kernel is, meshwear.kernels.contact._build): the full one, and one for a
+# scene of analytic planes whose bodies are too small for the threaded
+# kernel, which compiles none of the mesh counter-surfaces' kernels nor the
+# threaded contact (numba prunes the branches of a constant False before
+# typing them): a first run of such a scene compiles a fifth of the code.
+#: the build's constants: mesh counter-surfaces, the threaded contact kernel,
+#: and the serial contact kernel it calls
+MESHES, PARALLEL, SERIAL_CONTACT = True, True, contact_serial
+
+
 def _fill(body, planes, surfaces, t, buffer, rotation, frame):
     """The planes of every surface at ``t`` under the body's active vertices."""
     vertices, pose = body[0], body[1]
@@ -63,12 +73,12 @@ def _fill(body, planes, surfaces, t, buffer, rotation, frame):
         if moving[j]:
             plane_rows(plane_motion[j], plane_terms[j], normal0[j], point0[j], t, buffer,
                        plane_array[j])
-    for j in range(len(surfaces)):
-        fill_planes(surfaces[j], t, vertices, pose, active, vertex_planes[j], distance, hint[j],
-                    buffer, rotation, frame)
+    if MESHES:
+        for j in range(len(surfaces)):
+            fill_planes(surfaces[j], t, vertices, pose, active, vertex_planes[j], distance,
+                        hint[j], buffer, rotation, frame)
 
 
-@njit(cache=True)
 def _touch(body, plane_array):
     """One step of the contact kernel; the normal forces and their squares
     added to ``load``."""
@@ -76,12 +86,12 @@ def _touch(body, plane_array):
      friction_work, wear_depth, wear_volume, wrench, vertex_planes, hint, active, active_wear,
      cull, distance, load, radius, depth_limit, impact_room) = body
     slots = plane_array.shape[0] + vertex_planes.shape[0]
-    if active.shape[0] * slots >= PARALLEL_THRESHOLD:
+    if PARALLEL and active.shape[0] * slots >= PARALLEL_THRESHOLD:
         contact_parallel(vertices, pose, plane_array, vertex_planes, active, area, law,
                          wear_direction, contact_state, tangential, normal_force, friction_work,
                          wear_depth, wear_volume, wrench)
     else:
-        contact_serial(vertices, pose, plane_array, vertex_planes, active, area, law,
+        SERIAL_CONTACT(vertices, pose, plane_array, vertex_planes, active, area, law,
                        wear_direction, contact_state, tangential, normal_force, friction_work,
                        wear_depth, wear_volume, wrench)
     if load.shape[1]:
@@ -180,9 +190,8 @@ def _needs_refresh(body, bounds, terms, t, dt, buffer, cull_enabled):
             + step_motion(pose, radius, bounds, terms, t, dt, buffer) >= cull[0])
 
 
-@njit(cache=True)
-def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, surfaces, bounds,
-                 terms, report):
+def _advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, surfaces, bounds,
+                  terms, report):
     """Step one body from step ``k`` up to ``stop``. Returns ``(step, what)``:
     the step reached and :data:`DONE` (``step == stop``), :data:`REFRESH`
     (step ``step`` needs an active-set refresh first; nothing of it is done),
@@ -201,8 +210,9 @@ def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, 
     plane_array = planes[0]
     n_planes = plane_array.shape[0]
     worn = False
-    for m in range(len(surfaces)):
-        worn = worn or surfaces[m][14][0][0] >= 0.0
+    if MESHES:
+        for m in range(len(surfaces)):
+            worn = worn or surfaces[m][14][0][0] >= 0.0
     rotation, frame = np.zeros((3, 3)), np.zeros((4, 3))
     placed = np.zeros(13)
     no_scale = np.zeros(0)
@@ -216,8 +226,8 @@ def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, 
                 return k, REFRESH
             _fill(body, planes, surfaces, t, buffer, rotation, frame)
             _touch(body, plane_array)
-            if worn and not _wear_parts(body, surfaces, law, n_planes, t, buffer,
-                                        rotation, frame, report):
+            if MESHES and worn and not _wear_parts(body, surfaces, law, n_planes, t, buffer,
+                                                   rotation, frame, report):
                 return k, TOO_DEEP
             if depth_limit > 0.0:
                 slot, vertex = impact_check(vertices, pose, plane_array, vertex_planes, active,
@@ -261,8 +271,32 @@ def advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes, 
                                                     body[9], active, body[15], buffer) >= cull[0]:
                 return k, FINISH
         _touch(body, plane_array)
-        if worn and not _wear_parts(body, surfaces, law, n_planes, t, buffer, rotation,
-                                    frame, report):
+        if MESHES and worn and not _wear_parts(body, surfaces, law, n_planes, t, buffer,
+                                               rotation, frame, report):
             return k, TOO_DEEP
         k += 1
     return k, DONE
+
+
+def _loop_build(name, **constants):
+    """The loop compiled with ``constants`` (see :data:`MESHES`) under ``name``."""
+    fill = njit(cache=True)(_named_copy(_fill, "_fill" + name, **constants))
+    touch = njit(cache=True)(_named_copy(_touch, "_touch" + name, **constants))
+    return njit(cache=True)(_named_copy(_advance_body, "advance_body" + name, _fill=fill,
+                                        _touch=touch, **constants))
+
+
+#: the loop: every counter-surface, both contact kernels
+advance_body = _loop_build("")
+#: the loop of analytic planes, one plane and bodies of fewer vertices than
+#: the threaded kernel's threshold: the serial one-plane contact only
+advance_body_one_plane = _loop_build("_one_plane", MESHES=False, PARALLEL=False,
+                                     SERIAL_CONTACT=BUILDS["contact_serial"][1])
+
+
+def loop_for(model):
+    """The build of :func:`advance_body` that ``model`` needs."""
+    if (model.planes.shape[0] == 1 and not model.surfaces.per_vertex
+            and all(len(b.tributary_area) < PARALLEL_THRESHOLD for b in model.bodies)):
+        return advance_body_one_plane
+    return advance_body
