@@ -51,7 +51,7 @@ from .kernels.contact import NO_CONTACT, SLIP, STICK
 from .kernels.elastic import gaps
 from .kernels.laws import LAWS, name_of
 from .kernels.rigid import OSCILLATION, STEADY
-from .motion import BalancedMotion
+from .motion import BalancedMotion, _perpendicular
 from .surfaces.base import quaternion_matrix
 
 #: the normal problem is solved again when the gaps changed (rigid moves
@@ -162,16 +162,6 @@ class Patch:
 class PatchError(RuntimeError):
     """A contact the half-space model cannot take (too conforming, no
     normal along the load)."""
-
-
-def _perpendicular(n, hint):
-    e = hint - (hint @ n) * n
-    if np.linalg.norm(e) < 1e-9:
-        for guess in np.eye(3):
-            e = guess - (guess @ n) * n
-            if np.linalg.norm(e) > 1e-6:
-                break
-    return e / np.linalg.norm(e)
 
 
 def _stroke(motion):
@@ -300,7 +290,7 @@ def step(model, body, s, t, before, at_rest=False):
     if patch is None:
         normal = n[np.argmin(gap)].copy()
         stroke = _stroke(motion)
-        e1 = _perpendicular(normal, stroke if stroke is not None else np.array([1.0, 0, 0]))
+        e1 = _perpendicular(normal, stroke)
         patch = s.elastic = Patch(e1=e1, e2=np.cross(normal, e1), normal=normal)
         patch.extra.update(youngs=elastic.youngs, poisson=elastic.poisson)
     beta = float(motion.axis @ patch.normal) if balanced else 1.0
@@ -438,11 +428,17 @@ def counter_pairs(s):
     the vertices that dissipated energy slip, each with the force whose
     Coulomb slip at its speed dissipates that energy; the others nothing."""
     patch = s.elastic
-    state, force = np.zeros_like(s.contact_state), np.zeros_like(s.normal_force)
-    if patch is not None and patch.counter is not None:
-        idx, f = patch.counter
-        state[0, idx] = SLIP
-        force[0, idx] = f
+    if patch is None:
+        return list(zip(np.zeros_like(s.contact_state), np.zeros_like(s.normal_force)))
+    # allocated once, the last step's entries cleared (not the whole arrays)
+    if "counter_pairs" not in patch.extra:
+        patch.extra["counter_pairs"] = (np.zeros_like(s.contact_state),
+                                        np.zeros_like(s.normal_force), np.zeros(0, np.int64))
+    state, force, last = patch.extra["counter_pairs"]
+    state[0, last], force[0, last] = NO_CONTACT, 0.0
+    idx, f = patch.counter if patch.counter is not None else (last[:0], 0.0)
+    state[0, idx], force[0, idx] = SLIP, f
+    patch.extra["counter_pairs"] = (state, force, idx)
     return list(zip(state, force))
 
 

@@ -166,32 +166,8 @@ def solve(grid, gap, load, mask=None, kernel="normal", start=None, tol=1e-10,
     else:
         p = allowed.astype(float)         # uniform, as Polonsky and Keer start
     p *= load / (p.sum() * area)
-    t = np.zeros_like(h)
-    g_old, conjugate = 1.0, False
-    residual = np.inf
-    for iteration in range(1, max_iterations + 1):
-        g = grid.convolve(p, kernel) + h
-        touching = p > 0.0
-        mean = g[touching].mean()
-        g -= mean
-        G = float(g[touching] @ g[touching])
-        t = np.where(touching, g + (G / g_old if conjugate else 0.0) * t, 0.0)
-        g_old = G
-        r = grid.convolve(t, kernel)
-        r -= r[touching].mean()
-        denominator = float(r[touching] @ t[touching])
-        tau = float(g[touching] @ t[touching]) / denominator if denominator != 0.0 else 0.0
-        previous = p
-        p = p - tau * t
-        p = np.where(allowed, np.maximum(p, 0.0), 0.0)
-        overlap = allowed & (p == 0.0) & (g < 0.0)
-        conjugate = not overlap.any()
-        p = np.where(overlap, p - tau * g, p)
-        p *= load / (p.sum() * area)
-        residual = float(np.abs(p - previous).sum() * area / load)
-        if residual < tol:
-            break
-    g = grid.convolve(p, kernel) + h
+    p, u, iteration, residual = _iterate(grid, h, allowed, kernel, p, tol, max_iterations, load)
+    g = u + h
     touching = p > 0.0
     approach = float(g[touching].mean())
     return Solution(p, approach, np.where(allowed, g - approach, np.inf), iteration, residual)
@@ -199,7 +175,7 @@ def solve(grid, gap, load, mask=None, kernel="normal", start=None, tol=1e-10,
 
 def _solve_approach(grid, h, approach, allowed, kernel, start, tol, max_iterations):
     """:func:`solve` at a given ``approach``: the same conjugate gradient
-    without the load's constraint (no mean removed, no rescaling)."""
+    without the load's constraint (:func:`_iterate`)."""
     if start is not None and np.any(start[allowed] > 0.0):
         p = np.where(allowed, np.maximum(start, 0.0), 0.0)
     else:
@@ -210,19 +186,35 @@ def _solve_approach(grid, h, approach, allowed, kernel, start, tol, max_iteratio
         p = np.where(allowed, np.maximum(approach - h, 0.0) / own, 0.0)
     if not p.any():
         return Solution(p, approach, np.where(allowed, h - approach, np.inf), 0, 0.0)
+    p, u, iteration, residual = _iterate(grid, h, allowed, kernel, p, tol, max_iterations,
+                                         approach=approach)
+    return Solution(p, approach, np.where(allowed, u + h - approach, np.inf), iteration, residual)
+
+
+def _iterate(grid, h, allowed, kernel, p, tol, max_iterations, load=None, approach=0.0):
+    """Polonsky and Keer's constrained conjugate gradient from the traction
+    ``p``: with ``load``, the total kept (the mean gap of the cells in
+    contact removed, the traction rescaled at each iteration), else at the
+    given ``approach``. Returns the traction, its displacement ``u``, the
+    iterations and the residual (the traction's relative change in the last
+    iteration)."""
+    area = grid.cell_area
     t = np.zeros_like(h)
     g_old, conjugate = 1.0, False
-    residual = np.inf
+    iteration, residual = 0, np.inf
     u = grid.convolve(p, kernel)
     for iteration in range(1, max_iterations + 1):
-        g = u + h - approach
+        g = u + h
         touching = p > 0.0
         if not touching.any():
             break
+        g -= g[touching].mean() if load is not None else approach
         G = float(g[touching] @ g[touching])
         t = np.where(touching, g + (G / g_old if conjugate else 0.0) * t, 0.0)
         g_old = G
         r = grid.convolve(t, kernel)
+        if load is not None:
+            r -= r[touching].mean()
         denominator = float(r[touching] @ t[touching])
         tau = float(g[touching] @ t[touching]) / denominator if denominator != 0.0 else 0.0
         previous = p
@@ -231,18 +223,19 @@ def _solve_approach(grid, h, approach, allowed, kernel, start, tol, max_iteratio
         overlap = allowed & (p == 0.0) & (g < 0.0)
         conjugate = not overlap.any()
         p = np.where(overlap, p - tau * g, p)
-        # the displacement follows the step by linearity where no cell was
-        # clipped or added (the late iterations): one convolution, not two
-        if conjugate and np.array_equal(p, step):
-            u = u - tau * r
-        else:
+        if load is not None:
+            p *= load / (p.sum() * area)
+            residual = float(np.abs(p - previous).sum() * area / load)
             u = grid.convolve(p, kernel)
-        total = float(p.sum())
-        residual = float(np.abs(p - previous).sum() / total) if total > 0.0 else 0.0
+        else:
+            # the displacement follows the step by linearity where no cell
+            # was clipped or added (the late iterations): one convolution
+            u = u - tau * r if conjugate and np.array_equal(p, step) else grid.convolve(p, kernel)
+            total = float(p.sum())
+            residual = float(np.abs(p - previous).sum() / total) if total > 0.0 else 0.0
         if residual < tol:
             break
-    g = grid.convolve(p, kernel) + h - approach
-    return Solution(p, approach, np.where(allowed, g, np.inf), iteration, residual)
+    return p, u, iteration, residual
 
 
 def shear_at_shift(grid, pressure, friction, shift, turn=None, turn_shift=0.0, start=None,

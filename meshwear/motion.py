@@ -71,10 +71,12 @@ class Path:
         return self.buffer[1].copy()
 
 
-def _perpendicular(normal):
-    """A unit vector perpendicular to ``normal``: the world x axis projected on
-    the plane, or y when x is (nearly) along the normal."""
-    for guess in (np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])):
+def _perpendicular(normal, hint=None):
+    """A unit vector perpendicular to ``normal``: ``hint`` (if given), else the
+    world x axis, projected on the plane, or y when that is (nearly) along
+    the normal."""
+    guesses = [np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])]
+    for guess in ([np.asarray(hint, float)] if hint is not None else []) + guesses:
         e = guess - (guess @ normal) * normal
         if np.linalg.norm(e) > 1e-6:
             return e / np.linalg.norm(e)

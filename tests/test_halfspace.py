@@ -8,6 +8,8 @@ import pytest
 
 from meshwear.halfspace import contact_modulus, make_grid, solve, solve_shear
 
+from cases import fretting_loop, mindlin_deresiewicz
+
 E, NU = 210e9, 0.3
 G = E / (2.0 * (1.0 + NU))
 E_STAR = contact_modulus((E, E), (NU, NU))
@@ -94,18 +96,8 @@ def test_mindlin_deresiewicz_energy_per_fretting_cycle(sphere, share):
     turning point's shear: the loop's area against
     (9/10) mu^2 P^2 C_t / a [1 - (1 - x)^(5/3) - (5x/6)(1 + (1 - x)^(2/3))]."""
     grid, _, solution = sphere
-    p = solution.traction
-    top = share * MU * LOAD
-    q_top, _, s_top = solve_shear(grid, p, MU, top)
-    q_bottom, _, s_bottom = solve_shear(grid, p, MU, -top, q_top, top, s_top)
-    forces = np.linspace(top, -top, 41)
-    down = [solve_shear(grid, p, MU, f, q_top, top, s_top)[2] for f in forces]
-    up = [solve_shear(grid, p, MU, f, q_bottom, -top, s_bottom)[2] for f in forces[::-1]]
-    loop = np.trapezoid(np.array(down) - np.array(up)[::-1], -forces)
-    compliance = 2.0 * (2.0 - NU) / G
-    expected = 0.9 * (MU * LOAD) ** 2 * compliance / A * (
-        1.0 - (1.0 - share) ** (5.0 / 3.0)
-        - 5.0 * share / 6.0 * (1.0 + (1.0 - share) ** (2.0 / 3.0)))
+    loop, s_top, s_bottom = fretting_loop(grid, solution.traction, MU, share * MU * LOAD)
+    expected = mindlin_deresiewicz(MU, LOAD, 2.0 * (2.0 - NU) / G, A, share)
     assert loop == pytest.approx(expected, rel=0.03)
     assert s_bottom == pytest.approx(-s_top, rel=1e-3)           # the loop closes
 
