@@ -15,11 +15,9 @@ Measured 2026-11-26 (400 cycles): with the flat unworn the cylinder's
 volume is k L s to 1e-4 at J = 5 and J = 40; with the flat worn it is
 0.983 k L s (J = 5) and 0.865 k L s (J = 40): each jump carries about
 1 - J/300 of J times its measured cycle's volume (docs/model.md, "Worn
-counter-surfaces": the counter's relief under a body vertex is taken at the
-vertex's foot at the cycle's end, not along its path over the stroke).
-Step doubling does not see it (its 1, 2 and 4 steps share the relief), so
-the drift bound, which holds the example's jumps at 5-35 cycles, is what
-keeps the run within a few per cent.
+counter-surfaces", "Known error"). Step doubling does not see it, so the
+drift bound, which holds the example's jumps at 5-35 cycles, is what keeps
+the run within a few per cent.
 """
 
 import argparse
