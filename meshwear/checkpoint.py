@@ -112,7 +112,13 @@ def save(path, model, state, wall_time):
             arrays[f"jump_part{k}_error"] = error
             if rate is not None:
                 arrays[f"jump_part{k}_rate"] = rate
-        arrays["jump_noise_var"] = np.array(list(js.noise_var) + list(js.part_noise_var))
+        for k, variance in enumerate(js.noise_var):
+            arrays[f"jump{k}_noise_var"] = variance
+        for k, variance in enumerate(js.part_noise_var):
+            arrays[f"jump_part{k}_noise_var"] = variance
+        arrays["jump_bias"] = np.array(js.bias, dtype=float).reshape(-1, 2)
+        arrays["jump_volumes"] = np.array([[t, *v] for t, v in js.volumes],
+                                          dtype=float).reshape(-1, 1 + len(state.bodies))
         arrays["jump_window"] = np.array([js.window, js.relax])
         arrays["jump_history_times"] = np.array([t for t, _, _ in js.history])
         for h, (_, alphas, part_rates) in enumerate(js.history):
@@ -216,8 +222,19 @@ def load(path, model, state):
         if "jump_window" in data:
             window, relax = data["jump_window"]
             js.window, js.relax = int(window), float(relax)
-            variance = [float(v) for v in data["jump_noise_var"]]
-            js.noise_var, js.part_noise_var = variance[:n], variance[n:]
+            if "jump_bias" in data:
+                js.noise_var = [data[f"jump{k}_noise_var"].copy() for k in range(n)]
+                js.part_noise_var = [data[f"jump_part{k}_noise_var"].copy()
+                                     for k in range(len(worn))]
+                js.bias = [b.copy() for b in np.atleast_2d(data["jump_bias"])]
+                js.volumes = [(float(row[0]), row[1:].copy()) for row in data["jump_volumes"]]
+            else:
+                # an older checkpoint: one variance per part, for every vertex
+                variance = [float(v) for v in data["jump_noise_var"]]
+                js.noise_var = [np.full(len(s.wear_depth), v)
+                                for s, v in zip(state.bodies, variance[:n])]
+                js.part_noise_var = [np.full(len(p.depth), v)
+                                     for p, v in zip(worn, variance[n:])]
             for h, t in enumerate(data["jump_history_times"]):
                 alphas = [data[f"jump_history{h}_alpha{k}"].copy() for k in range(n)
                           if f"jump_history{h}_alpha{k}" in data]

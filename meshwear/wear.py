@@ -62,6 +62,10 @@ MAX_WINDOW = 8
 #: the bounds that read sampling noise: when one holds the jumps under twice
 #: the cycles a measurement resolves, the measurements average over twice as many
 NOISY = ("noise", "counter noise")
+#: the bounds that keep the errors so far within the tolerance: a cycle they
+#: refuse lets the contact relax them, and the jumps after it grow from the
+#: last one taken, not from one again
+BUDGET = ("drift", "noise", "counter noise")
 #: measurements (this one included) a vertex's drift and noise are fitted over
 HISTORY = 8
 
@@ -75,7 +79,9 @@ class JumpState:
     last_jump: int = 0
     jumps: int = 0
     resolved_steps: int = 0
-    error: list = field(default_factory=list)      # per body (n,) estimated error of w (m)
+    error: list = field(default_factory=list)      # per body (n,) estimated error of w (m),
+                                                    # step doubling's and drift's, as the
+                                                    # contact has relaxed it since
     settling: bool = False                          # dynamic: the next cycle only settles
     alpha: list = field(default_factory=list)      # per body (n,) implicit: wear per cycle per
                                                     # unit penetration, last measured (0: none)
@@ -83,12 +89,12 @@ class JumpState:
     part_rate: list = field(default_factory=list)  # per worn counter-part (V,) wear per
                                                     # cycle, last measured (or None)
     part_error: list = field(default_factory=list)  # per worn counter-part (V,) estimated
-                                                     # error of its depth (m)
-    part_noise: list = field(default_factory=list)  # per worn counter-part: the sampling
+                                                     # error of its depth (m), relaxed
+    part_noise: list = field(default_factory=list)  # per worn counter-part (V,): the sampling
                                                      # noise of its wear per cycle (m) in this
                                                      # measurement, from ``history`` (None:
                                                      # too few; not saved: measured anew)
-    part_noise_var: list = field(default_factory=list)  # per worn counter-part: the
+    part_noise_var: list = field(default_factory=list)  # per worn counter-part (V,): the
                                                      # variance (m^2) the jumps' noise added
                                                      # to its depth (random across jumps)
     window: int = 1                                 # resolved cycles a measurement averages
@@ -96,8 +102,11 @@ class JumpState:
                                                     # (at most HISTORY - 1): (their middle,
                                                     # cycles; per body alpha; per part rate)
     relax: float = np.inf                           # cycles the contact relaxes errors over
-    noise_var: list = field(default_factory=list)  # per body: the variance (m^2) the jumps'
-                                                    # noise added to its depth
+    noise_var: list = field(default_factory=list)  # per body (n,): the variance (m^2) the
+                                                    # jumps' noise added to its depth
+    bias: list = field(default_factory=list)       # per body: the part of its errors common
+                                                    # to the whole contact (m), which the
+                                                    # contact does not relax (:func:`_after`)
     # not saved with checkpoints: what the run has done since it (re)started,
     # for meshwear check's estimate
     last_limit: str | None = None                   # the bound that set the latest jump,
@@ -107,6 +116,11 @@ class JumpState:
     taken: list = field(default_factory=list)       # the jumps taken: (cycle it starts at,
                                                     # cycles, the bound that set it)
     cycle_start: int = 0                            # the step the cycle being resolved began at
+    volumes: list = field(default_factory=list)     # the measurements at this window (at
+                                                    # most HISTORY): (their middle, cycles;
+                                                    # per body its worn volume per cycle, m^3)
+    noisy: bool = False                             # a jump of twice the window, by its own
+                                                    # noise alone, would break the tolerance
 
 
 def penetration(model, body, s):
@@ -187,9 +201,11 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
     if len(js.part_noise) != len(parts):
         js.part_noise = [None] * len(parts)
     if len(js.part_noise_var) != len(parts):
-        js.part_noise_var = [0.0] * len(parts)
+        js.part_noise_var = [np.zeros(len(p.depth)) for _, p in parts]
     if len(js.noise_var) != len(model.bodies):
-        js.noise_var = [0.0] * len(model.bodies)
+        js.noise_var = [np.zeros(len(s.wear_depth)) for s in state.bodies]
+    if len(js.bias) != len(model.bodies):
+        js.bias = [np.zeros(2) for _ in model.bodies]
     for body, s in zip(model.bodies, state.bodies):
         if s.load.shape[1] != len(s.wear_depth):
             s.load = np.zeros((2, len(s.wear_depth)))
@@ -235,6 +251,8 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
         for k, rate in enumerate(part_rates):
             js.part_noise[k] = _counter_noise(js, k, rate, middle)
         js.relax = _relaxation(measures)
+        _relax_resolved(js, measures, part_rates, window)
+        js.noisy = False
         part_limit, part_which = float("inf"), None
         if parts:
             increments = [None] * len(state.parts)
@@ -245,11 +263,20 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
             if forced_jump is None:
                 part_limit, part_which = _part_limit(model, parts, part_rates, js, measures,
                                                      tolerance, end_limit, implicit,
-                                                     min(could, end_limit))
+                                                     min(could, end_limit),
+                                                     _bodies_relative(js, state.bodies))
+        volumes = np.array([float((s.wear_volume - b[2]).sum()) / window
+                            for s, b in zip(state.bodies, before)])
+        js.volumes = (js.volumes + [(middle, volumes)])[-HISTORY:]
         if implicit:
+            def keep(results, jump):
+                return _keep_volume(model.bodies, measures, rates, state.bodies, before,
+                                    results, jump, window, js.volumes)
+
             jump, which, results = _choose_implicit(
                 measures, rates, js, end_limit, int(min(could, part_limit)), tolerance,
-                forced_jump, middle, [float(s.wear_depth.max(initial=0.0)) for s in state.bodies])
+                forced_jump, middle, [float(s.wear_depth.max(initial=0.0)) for s in state.bodies],
+                keep)
             if part_limit < could and (which == "growth" or part_limit < 1):
                 which = part_which       # the counter-parts bounded it (or refused it)
         else:
@@ -266,8 +293,9 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
             results = [(jump * rate, 0.0, _slope_error(rate, previous, js.gap, jump))
                        for rate, previous in zip(rates, js.rate)]
         if jump > 0:
-            for error, (_, _, estimate) in zip(js.error, results):
-                error += estimate
+            if not implicit:
+                for error, (_, _, estimate) in zip(js.error, results):
+                    error += estimate
             js.limits[which] = js.limits.get(which, 0) + 1
             js.last_limit = which
             factors = None
@@ -296,7 +324,8 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
             js.jumps += 1
             js.taken.append((stop / n_c, jump, which))
             js.settling = not model.quasi_static
-        js.last_jump = jump
+        if jump > 0 or which not in BUDGET:
+            js.last_jump = jump
         if jump == 0:
             js.last_limit = which        # why none was taken (the progress line says)
         js.rate = rates
@@ -311,13 +340,16 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                                       part_rates)])[1 - HISTORY:]
         following = window
         if (forced_jump is None and which in NOISY and jump < 2 * window
-                and window < MAX_WINDOW):
+                and window < MAX_WINDOW and js.noisy):
             # single measurements disagree by more than the jumps they allow
             # (a vertex at a contact's edge touched every other cycle, a
             # flank switching between two rates): average over more cycles,
-            # and measure the noise and the drift again at that window
+            # and measure the noise and the drift again at that window (not
+            # where the errors of the jumps before fill the tolerance: the
+            # resolved cycles relax them)
             following = js.window = 2 * window
             js.history = []
+            js.volumes = []
         # cycles between the middles of this measurement and the next
         js.gap = jump + 0.5 * (window + following) + (1.0 if js.settling else 0.0)
         if checkpoint is not None:
@@ -355,18 +387,20 @@ def _slope_error(rate, previous, gap, jump):
 
 
 def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=0.0,
-                     deepest=None):
+                     deepest=None, keep=None):
     """Cycles to jump over with implicit jumps, which bound set it, and per
-    body the jump's ``(wear, move, error estimate)``.
+    body the jump's ``(wear, move, step-doubling error estimate)``.
 
     Bounds: ``end`` (the run ends with a resolved cycle), ``could`` (the
     growth bound the snapshots were taken for, or a forced jump), the drift
     of each vertex's wear per unit penetration over the measurements at
-    this window (``rho_alpha pbar J^2 / 2 <= tol J r_max``, :func:`_trend`),
-    its noise about that drift (random from jump to jump,
-    :func:`_noise_bound` against each body's ``deepest`` wear), and step
-    doubling (the jump's estimated error ``<= tol J r_max``). ``t``: the
-    middle of this measurement (cycles)."""
+    this window (:func:`_trend`) and its noise about that drift: their
+    errors (the drift's relaxed by the contact, the noise's random from
+    jump to jump), with the step doubling's so far, within the tolerance of
+    each body's ``deepest`` wear (:func:`_budget_bound`); and step doubling
+    (the jump's estimated error ``<= tol J r_max``). ``t``: the middle of this measurement (cycles).
+    The jump taken adds its drift's error to ``js.drift`` and ``js.bias``,
+    its noise's to ``js.noise_var``."""
     fastest = max(float(r.max()) if len(r) else 0.0 for r in rates)
     if forced is not None:
         jump = min(end, could)
@@ -378,42 +412,233 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=
     # and the noise of its wear per cycle about it, sigma_i pbar_i
     trends = [_trend(m, [(time, alphas[k][m.index]) for time, alphas, _ in js.history], t)
               for k, m in enumerate(measures)]
-    drifts = [d for d, _ in trends]
-    drift = max(float(d.max(initial=0.0)) for d in drifts)
-    if drift > 0.0:
-        bounds["drift"] = 2.0 * tolerance * fastest / drift
-    for k, (_, noise) in enumerate(trends):
-        if noise is not None and len(noise) and deepest is not None:
-            bounds["noise"] = min(bounds.get("noise", np.inf), _noise_bound(
-                float(noise.max()), js.noise_var[k], tolerance, deepest[k],
-                float(rates[k].max(initial=0.0)), js.relax, min(end, could)))
+    deepest = [0.0] * len(measures) if deepest is None else deepest
+    top = [float(r.max(initial=0.0)) for r in rates]
+    if len(js.bias) != len(measures):            # (a state built by hand)
+        js.error = [np.zeros(len(r)) for r in rates]
+        js.noise_var = [np.zeros(len(r)) for r in rates]
+        js.bias = [np.zeros(2) for _ in rates]
+    for k, (m, (drift, noise)) in enumerate(zip(measures, trends)):
+        if noise is not None and len(noise):
+            js.noisy |= _alone(noise, js.window, tolerance, deepest[k], top[k])
+        if (noise is not None and noise.any()) or drift.any():
+            jump, which = _budget(js, k, m, drift, noise, tolerance, deepest[k], top[k],
+                                  min(end, could))
+            if jump < bounds.get(which, np.inf):
+                bounds[which] = float(jump)
     which = min(bounds, key=bounds.get)
     jump = int(np.floor(bounds[which]))
-    for _ in range(12):
+    for _ in range(40):
         if jump < 1:
-            return 0, which if which in ("noise", "drift") else "accuracy", None
+            return 0, which if which in ("noise", "drift", "volume") else "accuracy", None
         results = [jumps.implicit(m, jump) for m in measures]
         worst = max(float(e.max(initial=0.0)) for _, _, e in results) / (tolerance * jump
                                                                           * fastest)
-        if worst <= 1.0:
-            # the error estimate: step doubling's, and the drift's over the jump
-            # (the noise's, random from jump to jump, is kept apart)
-            results = [(w, z, e + 0.5 * d * jump * jump)
-                       for (w, z, e), d in zip(results, drifts)]
-            for k, (_, noise) in enumerate(trends):
-                if noise is not None and len(noise):
-                    js.noise_var[k] = _add_noise(js.noise_var[k], float(noise.max()), jump,
-                                                 js.relax)
-            return jump, which, _spread(measures, rates, jump, results)
-        # the error grows like J^3, its allowance like J
-        jump, which = int(jump * min(np.sqrt(0.9 / worst), 0.5 if worst > 4.0 else 0.9)), \
-            "accuracy"
-    return 0, "accuracy", None
+        if worst > 1.0:
+            # the error grows like J^3, its allowance like J
+            jump, which = int(jump * min(np.sqrt(0.9 / worst), 0.5 if worst > 4.0 else 0.9)), \
+                "accuracy"
+            continue
+        # every error of depth after the jump, this one's step doubling with
+        # them, within the tolerance
+        after = [_after(js, k, m, drift, noise, jump, e)
+                 for k, (m, (drift, noise), (_, _, e)) in enumerate(zip(measures, trends,
+                                                                        results))]
+        over = [_total(*a) > tolerance * (deepest[k] + jump * top[k]) for k, a in enumerate(after)]
+        if any(over):
+            k = over.index(True)
+            which = _dominant(*after[k])
+            jump = int(jump * 0.8) if jump > 4 else jump - 1
+            continue
+        spread = _spread(measures, rates, jump, results)
+        if keep is not None:
+            spread = keep(spread, jump)
+            if spread is None:
+                # the implicit step's volume is far off the measurements':
+                # the jump is too long for the contact's wear per unit
+                # penetration to hold (:func:`_keep_volume`)
+                jump, which = jump // 2, "volume"
+                continue
+        for k, (m, (local, variance, common)) in enumerate(zip(measures, after)):
+            js.error[k][m.index], js.noise_var[k][m.index], js.bias[k] = local, variance, common
+        return jump, which, spread
+    return 0, which if which == "volume" else "accuracy", None
+
+
+#: the most a load-carrying body's implicit jump may be off the volume its
+#: measurements give (a fraction): the jump is moved to it within this, and
+#: halved past it (:func:`_keep_volume`)
+KEEP = 0.25
+
+
+def _keep_volume(bodies, measures, rates, states, before, results, jump, window, volumes):
+    """The implicit jump's ``results`` with each load-carrying body's wear
+    (and move, and error) scaled so that its worn volume over the jump is
+    the one its measurements give: its volume per cycle ``volumes`` (the
+    last one this measurement's), on the straight line fitted through
+    them (:func:`_fit`), over the jump's cycles.
+
+    Under a load carried along a free axis the volume a cycle wears is the
+    load's work against the sliding (Archard's ``k L s`` when every point
+    slides alike), whatever the contact's shape; the implicit step, which
+    holds each vertex's wear per unit penetration fixed, moves the load
+    towards the vertices that wear least per unit of it (at a scar's edge,
+    in contact for part of the stroke, whose share of the stroke grows as
+    they are pressed harder) and loses volume as the jump grows (a cylinder
+    on a worn flat kept 0.87 of it at 40 cycles). The jump keeps the shape
+    the implicit step gives it and the volume of the measurements; None
+    (the jump is too long) where they differ by more than :data:`KEEP`.
+    Bodies that carry no load along an axis (a prescribed one, whose wear
+    relieves its contact) keep the implicit step's volume."""
+    times = np.array([t for t, _ in volumes])
+    rate = np.vstack([v for _, v in volumes])
+    slope = _fit(times, rate)[0] if len(volumes) > 2 else np.zeros(rate.shape[1])
+    out = []
+    for k, (body, m, r, s, b, (wear, move, error)) in enumerate(
+            zip(bodies, measures, rates, states, before, results)):
+        # the volume the jump plans (:func:`_jump`): each vertex's of the
+        # cycle scaled like its wear, and the vertices it brings into contact
+        cycle = (s.wear_volume - b[2]) / window
+        wearing = r > 0.0
+        planned = float((wear[wearing] / r[wearing]) @ cycle[wearing])
+        fresh = ~wearing & (wear > 0.0)
+        if fresh.any():
+            normal = np.zeros((len(r), 3))
+            normal[m.index] = m.normal
+            planned += float(wear[fresh] @ _fresh_area(body, s, fresh, normal))
+        target = jump * rate[-1, k] + 0.5 * jump * jump * slope[k]
+        if m.guided and m.load != 0.0 and target > 0.0:
+            if abs(planned - target) > KEEP * target:
+                return None
+            scale = target / planned
+            wear, move, error = wear * scale, move * scale, error * scale
+        out.append((wear, move, error))
+    return out
+
+
+def _after(js, k, m, drift, noise, jump, doubling=None):
+    """Body ``k``'s errors of depth (m) after one more jump of ``jump``
+    cycles, for the vertices of its measure ``m``: (k,) each one's
+    deterministic error, (k,) the variance of its random one, and the part
+    common to the whole contact.
+
+    A jump holds each vertex's ``alpha_i`` at its measured value, so a
+    drift ``rho_i pbar_i`` (``drift``, m per cycle per cycle, signed) makes
+    it wrong by ``rho_i pbar_i J^2 / 2``; the noise ``sigma_i`` of a
+    measured rate about that drift (``noise``, m per cycle, or None) by
+    ``J sigma_i``, random from jump to jump (so the variances add); the
+    jump's own step doubling estimates ``doubling`` (k,) (None: not yet
+    known). The contact relaxes an error of depth (a vertex worn too little
+    carries more and wears more) at its own and its counter-part's wear per
+    cycle per unit penetration, ``alpha_i + gamma_i``, so the errors left
+    before decay by ``e^{-(alpha_i + gamma_i) J}`` over the jump, except
+    their part common to the whole contact (its stiffness-weighted mean: a
+    guided body's balance takes a uniform error of depth off its move, not
+    its wear), which stays."""
+    decay = np.exp(-_relax_rate(m) * jump)
+    drifted = 0.5 * jump * jump * drift
+    doubling = np.zeros(len(drift)) if doubling is None else doubling
+    local = js.error[k][m.index] * decay + np.abs(drifted) + doubling
+    variance = js.noise_var[k][m.index] * decay * decay
+    if noise is not None:
+        variance = variance + (jump * noise) ** 2
+    # the common part: the drift's signed (rates that rise at the contact's
+    # edge and fall in its middle keep the volume), step doubling's not
+    weight = np.where(m.mean > 0.0, m.stiffness, 0.0)
+    total = float(weight.sum())
+    common = np.array(js.bias[k], dtype=float)
+    if total > 0.0:
+        common = common + np.array([weight @ drifted, weight @ doubling]) / total
+    return local, variance, common
+
+
+def _total(local, variance, common):
+    """The largest error of depth (m) of :func:`_after`'s errors: a vertex's
+    deterministic one plus the root of its variance, plus the common part."""
+    return float((local + np.sqrt(variance)).max(initial=0.0)) + _common(common)
+
+
+def _common(bias):
+    """The magnitude (m) of a body's common error ``bias``: (its drift's,
+    signed; its step doubling's)."""
+    return abs(float(bias[0])) + float(bias[1])
+
+
+def _dominant(local, variance, common):
+    """Which of the drift and the noise makes most of the largest error of
+    :func:`_after`'s errors."""
+    if not len(local):
+        return "drift"
+    i = int(np.argmax(local + np.sqrt(variance)))
+    return "noise" if np.sqrt(variance[i]) > local[i] + _common(common) else "drift"
+
+
+def _budget(js, k, m, drift, noise, tolerance, deepest, fastest, most):
+    """The longest jump, at most ``most`` cycles, after which body ``k``'s
+    errors of depth (:func:`_after`, the jump's step doubling aside) stay
+    within the tolerance of the depth it will have, ``tol (deepest + J r)``
+    (``fastest`` its fastest rate r), and which of the drift and the noise
+    holds it. Early in a run (``deepest`` small) this is the per-jump
+    ``rho_i pbar_i J^2 / 2 <= tol J r``; once the contact has worn in, the
+    errors it relaxes no longer add up and the jumps grow with the depth."""
+    jump = _within(lambda j: _total(*_after(js, k, m, drift, noise, j)), tolerance, deepest,
+                   fastest, most)
+    return jump, _dominant(*_after(js, k, m, drift, noise, max(jump, 1)))
+
+
+def _alone(noise, window, tolerance, deepest, fastest):
+    """Whether a jump of twice ``window`` cycles, by the error of its own
+    ``noise`` (m per cycle) alone, breaks ``tol (deepest + J r)``
+    (``fastest``: r)."""
+    jump = 2 * window
+    return bool(jump * float(noise.max(initial=0.0)) > tolerance * (deepest + jump * fastest))
+
+
+def _within(error, tolerance, deepest, fastest, most):
+    """The longest jump ``J``, at most ``most`` cycles, with ``error(J)``
+    (m) within ``tol (deepest + J r)`` (``fastest``: r), searched down from
+    ``most`` by a fifth at a time (0: none)."""
+    jump = int(most)
+    while jump >= 1:
+        if error(jump) <= tolerance * (deepest + jump * fastest):
+            return jump
+        jump = int(jump * 0.8) if jump > 4 else jump - 1
+    return 0
+
+
+def _relax_rate(m):
+    """(k,) the rate (1 / cycle) at which the contact relaxes an error of
+    depth of each vertex of body measure ``m``: its own and its
+    counter-part's wear per cycle per unit penetration (0 out of contact)."""
+    return m.alpha if m.gamma is None else m.alpha + m.gamma
+
+
+def _relax_resolved(js, measures, part_rates, window):
+    """Relax the errors of depth so far over the ``window`` resolved cycles
+    of a measurement, as the contact does (:func:`_after`): the bodies'
+    vertices at their own rates, a worn counter-part's vertices that wore
+    at the contact's (``js.relax``)."""
+    for k, m in enumerate(measures or ()):
+        if k < len(js.error) and len(js.error[k]) and m is not None:
+            decay = np.exp(-_relax_rate(m) * window)
+            js.error[k][m.index] *= decay
+            js.noise_var[k][m.index] *= decay * decay
+    decay = _part_decay(js, window)
+    for k, rate in enumerate(part_rates):
+        wearing = rate > 0.0
+        js.part_error[k][wearing] *= decay
+        js.part_noise_var[k][wearing] *= decay * decay
+
+
+def _part_decay(js, cycles):
+    """The factor by which a worn counter-part's errors of depth relax over
+    ``cycles`` cycles where it wears (over ``js.relax``, the contact's)."""
+    return float(np.exp(-cycles / js.relax)) if np.isfinite(js.relax) and js.relax > 0 else 1.0
 
 
 def _trend(m, past, t):
     """Per vertex of body measure ``m`` (measured at ``t``, cycles), the
-    drift of its wear per cycle (``rho_alpha pbar``, m per cycle per cycle)
+    drift of its wear per cycle (``rho_alpha pbar``, m per cycle per cycle, signed)
     and the noise of its wear per cycle about that drift (``sigma_alpha
     pbar``, m per cycle; None with fewer than three measurements), from
     :func:`_fit` of its wear per unit penetration ``alpha`` over ``past``
@@ -429,9 +654,9 @@ def _trend(m, past, t):
 
 def _fit(times, values):
     """A straight line fitted to each column of ``values`` (K, n) over
-    ``times`` (K,): (n,) the magnitude of its slope past the slope's own
-    uncertainty, and (n,) the scatter of the values about it (None with
-    fewer than three). Single measurements scatter about the line (a
+    ``times`` (K,): (n,) its slope, shrunk towards zero by twice the slope's
+    own uncertainty (zero within it), and (n,) the scatter of the values
+    about it (None with fewer than three). Single measurements scatter about the line (a
     vertex of a fine pad sliding over a finer worn flat sees its
     penetration change facet by facet, one at a pad's rim is touched
     every other cycle); counted as drift, that scatter would hold the
@@ -442,10 +667,10 @@ def _fit(times, values):
         return np.zeros(values.shape[1]), None
     slope = centred @ (values - values.mean(axis=0)) / spread
     if len(times) < 3:
-        return np.abs(slope), None
+        return slope, None
     residual = values - values.mean(axis=0) - np.outer(centred, slope)
     sigma = np.sqrt((residual * residual).sum(axis=0) / (len(times) - 2))
-    return np.maximum(np.abs(slope) - 2.0 * sigma / np.sqrt(spread), 0.0), sigma
+    return np.sign(slope) * np.maximum(np.abs(slope) - 2.0 * sigma / np.sqrt(spread), 0.0), sigma
 
 
 def _spread(measures, rates, jump, results=None):
@@ -525,7 +750,7 @@ def _jump(model, state, before, rates, jump, results, measures=None, window=1):
 
 
 def _part_limit(model, parts, part_rates, js, measures, tolerance, end, implicit=False,
-                most=None):
+                most=None, drifting=0.0):
     """The most cycles the worn counter-parts allow a jump, and the bound
     that sets it: a part vertex sinking by at most SPACING_FRACTION of its
     spacing per jump, the sampling noise of its wear per cycle within the
@@ -533,7 +758,10 @@ def _part_limit(model, parts, part_rates, js, measures, tolerance, end, implicit
     the counter's wear under each body vertex within :data:`THETA` of its
     penetration. ``implicit``: the jump relieves the counter's wear as the
     body's (:func:`meshwear.jumps.counter_factors`): the bodies' implicit
-    step bounds its accuracy and stability."""
+    step bounds its accuracy and stability. The noise's error, with the
+    part's others (its step doubling's, and the bodies' relative drift
+    error ``drifting``: the same contacts wear it), is kept within the
+    tolerance (:func:`_noise_bound`)."""
     bounds = {}
     for k, ((j, part), rate, previous) in enumerate(zip(parts, part_rates, js.part_rate)):
         if rate.max(initial=0.0) <= 0.0:
@@ -548,8 +776,11 @@ def _part_limit(model, parts, part_rates, js, measures, tolerance, end, implicit
         if js.part_noise[k] is None:
             return 0, "measuring"
         most = end if most is None else most
-        bound = _noise_bound(js.part_noise[k], js.part_noise_var[k], tolerance,
-                             float(part.depth.max()), float(rate.max()), js.relax, most)
+        deepest = float(part.depth.max())
+        js.noisy |= _alone(js.part_noise[k], js.window, tolerance, deepest, float(rate.max()))
+        bound = _noise_bound(js.part_noise[k], js.part_noise_var[k], js.part_error[k],
+                             rate > 0.0, tolerance, deepest, float(rate.max()), js.relax, most,
+                             drifting * deepest)
         if bound < 1.0 <= most:
             return 0, "counter noise"
         bounds["counter noise"] = min(bounds.get("counter noise", np.inf), bound)
@@ -614,6 +845,12 @@ def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None, 
         part.frames[:] = face_frames(part.vertices, surface.faces)
         surface.rebin()
         previous = js.part_rate[k]
+        # the errors so far relax where the part wears (implicit jumps:
+        # js.relax is the contact's time; explicit, none)
+        wearing = rate > 0.0
+        decay = _part_decay(js, jump)
+        js.part_error[k][wearing] *= decay
+        js.part_noise_var[k][wearing] *= decay * decay
         if relative is not None:
             js.part_error[k] += jump * rate * relative      # the bodies' implicit step's
         else:
@@ -621,39 +858,30 @@ def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None, 
         if js.part_noise[k] is not None:
             # the noise of one measurement's rate, times the jump: random
             # from jump to jump, so the jumps' errors add in quadrature
-            js.part_noise_var[k] = _add_noise(js.part_noise_var[k], js.part_noise[k], jump,
-                                              js.relax)
+            js.part_noise_var[k] += (jump * js.part_noise[k]) ** 2
         spans.append({name: (span[name], getattr(part, name).copy()) for name in PART_JUMPED})
     return spans
 
 
-def _noise_bound(noise, variance, tolerance, deepest, fastest, relax, most):
-    """The longest jump, at most ``most`` cycles, whose noise keeps a
-    part's random error within the tolerance. A jump's error, ``J`` times
-    the noise ``sigma`` (m per cycle) of the rate it extrapolates, is random
-    from jump to jump, so the jumps' errors add in quadrature
-    (:func:`_add_noise`; ``variance`` so far, m^2), and the contact relaxes
-    them as it does any error of depth (over ``relax`` cycles, the inverse
-    of its wear per cycle per unit penetration): the jump is taken when
-    ``variance e^(-2J/relax) + (J sigma)^2 <= (tol (deepest + J r))^2``,
-    ``deepest + J r`` the depth the part will have (``fastest`` its fastest
-    rate r)."""
-    jump = int(most)
-    while jump >= 1:
-        if _add_noise(variance, noise, jump, relax) <= (tolerance * (deepest + jump * fastest)) ** 2:
-            return jump
-        jump = int(jump * 0.8) if jump > 4 else jump - 1
-    return 0
+def _noise_bound(noise, variance, error, wearing, tolerance, deepest, fastest, relax, most,
+                 other=0.0):
+    """The longest jump, at most ``most`` cycles, after which a worn
+    counter-part's errors of depth, with ``other`` (m), stay within the
+    tolerance of the depth it will have, ``tol (deepest + J r)`` (``fastest``
+    its fastest rate r), per vertex: its deterministic ``error`` (m) and its
+    noise's, ``J`` times the noise ``noise`` (m per cycle) of the rate the
+    jump extrapolates, random from jump to jump, so the jumps' errors add
+    in quadrature (``variance`` so far, m^2); the contact relaxes both over
+    ``relax`` cycles (the inverse of its wear per cycle per unit
+    penetration) where the part wears (``wearing``)."""
 
+    def total(jump):
+        decay = float(np.exp(-jump / relax)) if np.isfinite(relax) and relax > 0.0 else 1.0
+        own = np.where(wearing, decay, 1.0)
+        spread = np.sqrt(variance * own * own + (jump * noise) ** 2)
+        return other + float((error * own + spread).max(initial=0.0))
 
-def _add_noise(variance, noise, jump, relax):
-    """The variance (m^2) of a part's depth from the noise of its jumps'
-    rates, after one more jump of ``jump`` cycles with noise ``noise`` (m per
-    cycle): what it was, relaxed over the jump by the contact (a vertex worn
-    too deep carries less and wears less, ``relax`` cycles its time
-    constant), plus the new jump's."""
-    decay = np.exp(-2.0 * jump / relax) if np.isfinite(relax) and relax > 0.0 else 1.0
-    return variance * decay + (jump * noise) ** 2
+    return _within(total, tolerance, deepest, fastest, most)
 
 
 def _relaxation(measures):
@@ -669,8 +897,8 @@ def _relaxation(measures):
 
 
 def _counter_noise(js, k, rate, t):
-    """The sampling noise of worn counter-part ``k``'s wear per cycle (m):
-    the largest scatter (:func:`_fit`) of a vertex's rate about a straight
+    """The sampling noise of worn counter-part ``k``'s wear per cycle (V,)
+    (m): each vertex's scatter (:func:`_fit`) of its rate about a straight
     line through its rates ``rate`` in this measurement (its middle at
     ``t``, cycles) and the ones before at the same window (its drift taken
     off: the rates of a contact that widens fall cycle after cycle, and
@@ -680,25 +908,53 @@ def _counter_noise(js, k, rate, t):
         return None
     _, sigma = _fit(np.array([time for time, _ in past] + [t]),
                     np.vstack([r for _, r in past] + [rate]))
-    return float(sigma.max())
+    return sigma
 
 
 #: the arrays of a worn counter-part a jump extrapolates
 PART_JUMPED = ("depth", "volume", "work", "vertices")
 
 
+def _fresh_area(body, s, fresh, normal):
+    """The area (m^2) over which the vertices ``fresh`` (mask) of ``body``
+    (state ``s``) wear, pressed by the surfaces of world ``normal`` (n, 3):
+    their area vectors across it."""
+    local = normal[fresh] @ quaternion_matrix(s.pose[3:7])
+    return np.maximum(-np.einsum("ij,ij->i", body.area_vectors[fresh, 0:3], local), 0.0)
+
+
 def _wear_fresh(body, s, fresh, wear, normal, work_per_volume):
     """Wear ``wear[fresh]`` of vertices with no cycle increments to scale,
     pressed by the surfaces of world ``normal`` (n, 3)."""
-    R = quaternion_matrix(s.pose[3:7])
-    local = normal[fresh] @ R                    # the normal in the body frame
+    local = normal[fresh] @ quaternion_matrix(s.pose[3:7])   # the normal in the body frame
     direction = body.wear_direction[fresh] if len(body.wear_direction) else local
     depth = wear[fresh]
     s.vertices[fresh] += depth[:, None] * direction
-    area = -np.einsum("ij,ij->i", body.area_vectors[fresh, 0:3], local)
-    volume = depth * np.maximum(area, 0.0)
+    volume = depth * _fresh_area(body, s, fresh, normal)
     s.wear_volume[fresh] += volume
     s.friction_work[fresh] += work_per_volume * volume
+
+
+def _bodies_relative(js, bodies):
+    """The largest error of depth of the bodies ``bodies`` (states) that is
+    not random (:func:`_after`: a vertex's deterministic one plus the
+    common part), over each one's deepest wear."""
+    out = 0.0
+    for k, s in enumerate(bodies):
+        deepest = s.wear_depth.max() if len(s.wear_depth) else 0.0
+        if deepest > 0.0 and k < len(js.error):
+            common = _common(js.bias[k]) if k < len(js.bias) else 0.0
+            out = max(out, float((js.error[k].max(initial=0.0) + common) / deepest))
+    return out
+
+
+def _largest(error, variances, k, bias=None):
+    """The largest error of depth (m) of a part: a vertex's deterministic
+    ``error`` plus the root of its variance (``variances[k]``: (n,), or a
+    float of an older checkpoint), plus its common part (``bias[k]``)."""
+    variance = variances[k] if k < len(variances) else 0.0
+    common = _common(bias[k]) if bias is not None and k < len(bias) else 0.0
+    return float((error + np.sqrt(variance)).max(initial=0.0)) + common
 
 
 def error_estimate(state):
@@ -707,12 +963,16 @@ def error_estimate(state):
     if js is None:
         return 0.0
     worst = 0.0
+    for k, (error, s) in enumerate(zip(js.error, state.bodies)):
+        deepest = s.wear_depth.max() if len(s.wear_depth) else 0.0
+        if deepest > 0.0:
+            worst = max(worst, _largest(error, js.noise_var, k, js.bias) / deepest)
+    # a worn counter-part, worn by the same contacts, has the bodies'
+    # relative deterministic error besides its own
     worn = [p.depth for p in state.parts if p is not None]
-    noise = ([float(np.sqrt(v)) for v in js.noise_var] + [0.0] * len(js.error))[:len(js.error)]
-    noise += ([float(np.sqrt(v)) for v in js.part_noise_var] + [0.0] * len(worn))[:len(worn)]
-    for error, depth, random in zip(js.error + js.part_error,
-                                    [s.wear_depth for s in state.bodies] + worn, noise):
+    bodies = _bodies_relative(js, state.bodies) if worn else 0.0
+    for k, (error, depth) in enumerate(zip(js.part_error, worn)):
         deepest = depth.max() if len(depth) else 0.0
         if deepest > 0.0:
-            worst = max(worst, float((error.max() + random) / deepest))
+            worst = max(worst, _largest(error, js.part_noise_var, k) / deepest + bodies)
     return worst
