@@ -114,6 +114,8 @@ def save(path, model, state, wall_time):
                 arrays[f"jump_part{k}_rate"] = rate
         for k, variance in enumerate(js.noise_var):
             arrays[f"jump{k}_noise_var"] = variance
+        for k, drift in enumerate(js.drift):
+            arrays[f"jump{k}_drift"] = drift
         for k, variance in enumerate(js.part_noise_var):
             arrays[f"jump_part{k}_noise_var"] = variance
         arrays["jump_bias"] = np.array(js.bias, dtype=float).reshape(-1, 2)
@@ -224,6 +226,7 @@ def load(path, model, state):
             js.window, js.relax = int(window), float(relax)
             if "jump_bias" in data:
                 js.noise_var = [data[f"jump{k}_noise_var"].copy() for k in range(n)]
+                js.drift = [data[f"jump{k}_drift"].copy() for k in range(n)]
                 js.part_noise_var = [data[f"jump_part{k}_noise_var"].copy()
                                      for k in range(len(worn))]
                 js.bias = [b.copy() for b in np.atleast_2d(data["jump_bias"])]

@@ -79,9 +79,12 @@ class JumpState:
     last_jump: int = 0
     jumps: int = 0
     resolved_steps: int = 0
-    error: list = field(default_factory=list)      # per body (n,) estimated error of w (m),
-                                                    # step doubling's and drift's, as the
-                                                    # contact has relaxed it since
+    error: list = field(default_factory=list)      # per body (n,) estimated error of w (m):
+                                                    # step doubling's (explicit: the slope
+                                                    # criterion's), as the contact has
+                                                    # relaxed it since
+    drift: list = field(default_factory=list)      # per body (n,) the drift's error of w (m),
+                                                    # relaxed alike
     settling: bool = False                          # dynamic: the next cycle only settles
     alpha: list = field(default_factory=list)      # per body (n,) implicit: wear per cycle per
                                                     # unit penetration, last measured (0: none)
@@ -206,6 +209,8 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
         js.noise_var = [np.zeros(len(s.wear_depth)) for s in state.bodies]
     if len(js.bias) != len(model.bodies):
         js.bias = [np.zeros(2) for _ in model.bodies]
+    if len(js.drift) != len(model.bodies):
+        js.drift = [np.zeros(len(s.wear_depth)) for s in state.bodies]
     for body, s in zip(model.bodies, state.bodies):
         if s.load.shape[1] != len(s.wear_depth):
             s.load = np.zeros((2, len(s.wear_depth)))
@@ -263,15 +268,14 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
             if forced_jump is None:
                 part_limit, part_which = _part_limit(model, parts, part_rates, js, measures,
                                                      tolerance, end_limit, implicit,
-                                                     min(could, end_limit),
-                                                     _bodies_relative(js, state.bodies))
+                                                     min(could, end_limit))
         volumes = np.array([float((s.wear_volume - b[2]).sum()) / window
                             for s, b in zip(state.bodies, before)])
         js.volumes = (js.volumes + [(middle, volumes)])[-HISTORY:]
         if implicit:
-            def keep(results, jump):
+            def keep(results, jump, forced=False):
                 return _keep_volume(model.bodies, measures, rates, state.bodies, before,
-                                    results, jump, window, js.volumes)
+                                    results, jump, window, js.volumes, forced)
 
             jump, which, results = _choose_implicit(
                 measures, rates, js, end_limit, int(min(could, part_limit)), tolerance,
@@ -404,7 +408,8 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=
     fastest = max(float(r.max()) if len(r) else 0.0 for r in rates)
     if forced is not None:
         jump = min(end, could)
-        return jump, "forced", _spread(measures, rates, jump)
+        spread = _spread(measures, rates, jump)
+        return jump, "forced", spread if keep is None else keep(spread, jump, True)
     if fastest <= 0.0 or not js.history:
         return 0, "measuring", None
     bounds = {"end": float(end), "growth": float(could)}
@@ -414,18 +419,28 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=
               for k, m in enumerate(measures)]
     deepest = [0.0] * len(measures) if deepest is None else deepest
     top = [float(r.max(initial=0.0)) for r in rates]
-    if len(js.bias) != len(measures):            # (a state built by hand)
+    if len(js.bias) != len(measures) or len(js.drift) != len(measures):  # (built by hand)
         js.error = [np.zeros(len(r)) for r in rates]
+        js.drift = [np.zeros(len(r)) for r in rates]
         js.noise_var = [np.zeros(len(r)) for r in rates]
         js.bias = [np.zeros(2) for _ in rates]
+    most = min(end, could)
     for k, (m, (drift, noise)) in enumerate(zip(measures, trends)):
         if noise is not None and len(noise):
             js.noisy |= _alone(noise, js.window, tolerance, deepest[k], top[k])
-        if (noise is not None and noise.any()) or drift.any():
-            jump, which = _budget(js, k, m, drift, noise, tolerance, deepest[k], top[k],
-                                  min(end, could))
-            if jump < bounds.get(which, np.inf):
-                bounds[which] = float(jump)
+        if drift.any():
+            # the drift's error within the tolerance of what the jump adds
+            # (each jump's), or, with the errors of the jumps before as the
+            # contact has relaxed them, of the depth the body will have
+            steep = float(np.abs(drift).max())
+            own = 2.0 * tolerance * top[k] / steep
+            budget = _within(lambda j: _drift_total(*_after(js, k, m, drift, noise, j)),
+                             tolerance, deepest[k], top[k], most)
+            bounds["drift"] = min(bounds.get("drift", np.inf), max(own, float(budget)))
+        if noise is not None and noise.any():
+            budget = _within(lambda j: _noise_total(*_after(js, k, m, drift, noise, j)),
+                             tolerance, deepest[k], top[k], most)
+            bounds["noise"] = min(bounds.get("noise", np.inf), float(budget))
     which = min(bounds, key=bounds.get)
     jump = int(np.floor(bounds[which]))
     for _ in range(40):
@@ -439,17 +454,6 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=
             jump, which = int(jump * min(np.sqrt(0.9 / worst), 0.5 if worst > 4.0 else 0.9)), \
                 "accuracy"
             continue
-        # every error of depth after the jump, this one's step doubling with
-        # them, within the tolerance
-        after = [_after(js, k, m, drift, noise, jump, e)
-                 for k, (m, (drift, noise), (_, _, e)) in enumerate(zip(measures, trends,
-                                                                        results))]
-        over = [_total(*a) > tolerance * (deepest[k] + jump * top[k]) for k, a in enumerate(after)]
-        if any(over):
-            k = over.index(True)
-            which = _dominant(*after[k])
-            jump = int(jump * 0.8) if jump > 4 else jump - 1
-            continue
         spread = _spread(measures, rates, jump, results)
         if keep is not None:
             spread = keep(spread, jump)
@@ -459,8 +463,10 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=
                 # penetration to hold (:func:`_keep_volume`)
                 jump, which = jump // 2, "volume"
                 continue
-        for k, (m, (local, variance, common)) in enumerate(zip(measures, after)):
-            js.error[k][m.index], js.noise_var[k][m.index], js.bias[k] = local, variance, common
+        for k, (m, (drift, noise), (_, _, e)) in enumerate(zip(measures, trends, results)):
+            doubling, drifted, variance, common = _after(js, k, m, drift, noise, jump, e)
+            js.error[k][m.index], js.drift[k][m.index] = doubling, drifted
+            js.noise_var[k][m.index], js.bias[k] = variance, common
         return jump, which, spread
     return 0, which if which == "volume" else "accuracy", None
 
@@ -471,7 +477,8 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=
 KEEP = 0.25
 
 
-def _keep_volume(bodies, measures, rates, states, before, results, jump, window, volumes):
+def _keep_volume(bodies, measures, rates, states, before, results, jump, window, volumes,
+                 forced=False):
     """The implicit jump's ``results`` with each load-carrying body's wear
     (and move, and error) scaled so that its worn volume over the jump is
     the one its measurements give: its volume per cycle ``volumes`` (the
@@ -487,7 +494,8 @@ def _keep_volume(bodies, measures, rates, states, before, results, jump, window,
     they are pressed harder) and loses volume as the jump grows (a cylinder
     on a worn flat kept 0.87 of it at 40 cycles). The jump keeps the shape
     the implicit step gives it and the volume of the measurements; None
-    (the jump is too long) where they differ by more than :data:`KEEP`.
+    (the jump is too long) where they differ by more than :data:`KEEP`,
+    unless the jump is ``forced``.
     Bodies that carry no load along an axis (a prescribed one, whose wear
     relieves its contact) keep the implicit step's volume."""
     times = np.array([t for t, _ in volumes])
@@ -508,19 +516,21 @@ def _keep_volume(bodies, measures, rates, states, before, results, jump, window,
             planned += float(wear[fresh] @ _fresh_area(body, s, fresh, normal))
         target = jump * rate[-1, k] + 0.5 * jump * jump * slope[k]
         if m.guided and m.load != 0.0 and target > 0.0:
-            if abs(planned - target) > KEEP * target:
+            if abs(planned - target) > KEEP * target and not forced:
                 return None
-            scale = target / planned
-            wear, move, error = wear * scale, move * scale, error * scale
+            if planned > 0.0:
+                scale = target / planned
+                wear, move, error = wear * scale, move * scale, error * scale
         out.append((wear, move, error))
     return out
 
 
 def _after(js, k, m, drift, noise, jump, doubling=None):
     """Body ``k``'s errors of depth (m) after one more jump of ``jump``
-    cycles, for the vertices of its measure ``m``: (k,) each one's
-    deterministic error, (k,) the variance of its random one, and the part
-    common to the whole contact.
+    cycles, for the vertices of its measure ``m``: (k,) each one's step
+    doubling error, (k,) its drift's, (k,) the variance of its random one,
+    and the part common to the whole contact (the drift's, signed; step
+    doubling's).
 
     A jump holds each vertex's ``alpha_i`` at its measured value, so a
     drift ``rho_i pbar_i`` (``drift``, m per cycle per cycle, signed) makes
@@ -538,7 +548,6 @@ def _after(js, k, m, drift, noise, jump, doubling=None):
     decay = np.exp(-_relax_rate(m) * jump)
     drifted = 0.5 * jump * jump * drift
     doubling = np.zeros(len(drift)) if doubling is None else doubling
-    local = js.error[k][m.index] * decay + np.abs(drifted) + doubling
     variance = js.noise_var[k][m.index] * decay * decay
     if noise is not None:
         variance = variance + (jump * noise) ** 2
@@ -549,41 +558,26 @@ def _after(js, k, m, drift, noise, jump, doubling=None):
     common = np.array(js.bias[k], dtype=float)
     if total > 0.0:
         common = common + np.array([weight @ drifted, weight @ doubling]) / total
-    return local, variance, common
+    return (js.error[k][m.index] * decay + doubling, js.drift[k][m.index] * decay
+            + np.abs(drifted), variance, common)
 
 
-def _total(local, variance, common):
-    """The largest error of depth (m) of :func:`_after`'s errors: a vertex's
-    deterministic one plus the root of its variance, plus the common part."""
-    return float((local + np.sqrt(variance)).max(initial=0.0)) + _common(common)
+def _drift_total(doubling, drift, variance, common):
+    """The largest drift error of depth (m) of :func:`_after`'s errors, a
+    vertex's and the common part."""
+    return float(drift.max(initial=0.0)) + abs(float(common[0]))
+
+
+def _noise_total(doubling, drift, variance, common):
+    """The largest random error of depth (m) of :func:`_after`'s errors:
+    the root of a vertex's variance."""
+    return float(np.sqrt(variance.max(initial=0.0)))
 
 
 def _common(bias):
     """The magnitude (m) of a body's common error ``bias``: (its drift's,
     signed; its step doubling's)."""
     return abs(float(bias[0])) + float(bias[1])
-
-
-def _dominant(local, variance, common):
-    """Which of the drift and the noise makes most of the largest error of
-    :func:`_after`'s errors."""
-    if not len(local):
-        return "drift"
-    i = int(np.argmax(local + np.sqrt(variance)))
-    return "noise" if np.sqrt(variance[i]) > local[i] + _common(common) else "drift"
-
-
-def _budget(js, k, m, drift, noise, tolerance, deepest, fastest, most):
-    """The longest jump, at most ``most`` cycles, after which body ``k``'s
-    errors of depth (:func:`_after`, the jump's step doubling aside) stay
-    within the tolerance of the depth it will have, ``tol (deepest + J r)``
-    (``fastest`` its fastest rate r), and which of the drift and the noise
-    holds it. Early in a run (``deepest`` small) this is the per-jump
-    ``rho_i pbar_i J^2 / 2 <= tol J r``; once the contact has worn in, the
-    errors it relaxes no longer add up and the jumps grow with the depth."""
-    jump = _within(lambda j: _total(*_after(js, k, m, drift, noise, j)), tolerance, deepest,
-                   fastest, most)
-    return jump, _dominant(*_after(js, k, m, drift, noise, max(jump, 1)))
 
 
 def _alone(noise, window, tolerance, deepest, fastest):
@@ -623,6 +617,8 @@ def _relax_resolved(js, measures, part_rates, window):
             decay = np.exp(-_relax_rate(m) * window)
             js.error[k][m.index] *= decay
             js.noise_var[k][m.index] *= decay * decay
+            if k < len(js.drift) and len(js.drift[k]):
+                js.drift[k][m.index] *= decay
     decay = _part_decay(js, window)
     for k, rate in enumerate(part_rates):
         wearing = rate > 0.0
@@ -750,7 +746,7 @@ def _jump(model, state, before, rates, jump, results, measures=None, window=1):
 
 
 def _part_limit(model, parts, part_rates, js, measures, tolerance, end, implicit=False,
-                most=None, drifting=0.0):
+                most=None):
     """The most cycles the worn counter-parts allow a jump, and the bound
     that sets it: a part vertex sinking by at most SPACING_FRACTION of its
     spacing per jump, the sampling noise of its wear per cycle within the
@@ -758,10 +754,8 @@ def _part_limit(model, parts, part_rates, js, measures, tolerance, end, implicit
     the counter's wear under each body vertex within :data:`THETA` of its
     penetration. ``implicit``: the jump relieves the counter's wear as the
     body's (:func:`meshwear.jumps.counter_factors`): the bodies' implicit
-    step bounds its accuracy and stability. The noise's error, with the
-    part's others (its step doubling's, and the bodies' relative drift
-    error ``drifting``: the same contacts wear it), is kept within the
-    tolerance (:func:`_noise_bound`)."""
+    step bounds its accuracy and stability; its noise's error is kept within
+    the tolerance (:func:`_noise_bound`)."""
     bounds = {}
     for k, ((j, part), rate, previous) in enumerate(zip(parts, part_rates, js.part_rate)):
         if rate.max(initial=0.0) <= 0.0:
@@ -778,9 +772,8 @@ def _part_limit(model, parts, part_rates, js, measures, tolerance, end, implicit
         most = end if most is None else most
         deepest = float(part.depth.max())
         js.noisy |= _alone(js.part_noise[k], js.window, tolerance, deepest, float(rate.max()))
-        bound = _noise_bound(js.part_noise[k], js.part_noise_var[k], js.part_error[k],
-                             rate > 0.0, tolerance, deepest, float(rate.max()), js.relax, most,
-                             drifting * deepest)
+        bound = _noise_bound(js.part_noise[k], js.part_noise_var[k], rate > 0.0, tolerance,
+                             deepest, float(rate.max()), js.relax, most)
         if bound < 1.0 <= most:
             return 0, "counter noise"
         bounds["counter noise"] = min(bounds.get("counter noise", np.inf), bound)
@@ -863,23 +856,20 @@ def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None, 
     return spans
 
 
-def _noise_bound(noise, variance, error, wearing, tolerance, deepest, fastest, relax, most,
-                 other=0.0):
+def _noise_bound(noise, variance, wearing, tolerance, deepest, fastest, relax, most):
     """The longest jump, at most ``most`` cycles, after which a worn
-    counter-part's errors of depth, with ``other`` (m), stay within the
-    tolerance of the depth it will have, ``tol (deepest + J r)`` (``fastest``
-    its fastest rate r), per vertex: its deterministic ``error`` (m) and its
-    noise's, ``J`` times the noise ``noise`` (m per cycle) of the rate the
-    jump extrapolates, random from jump to jump, so the jumps' errors add
-    in quadrature (``variance`` so far, m^2); the contact relaxes both over
-    ``relax`` cycles (the inverse of its wear per cycle per unit
-    penetration) where the part wears (``wearing``)."""
+    counter-part's random errors of depth stay within the tolerance of the
+    depth it will have, ``tol (deepest + J r)`` (``fastest`` its fastest
+    rate r): per vertex, ``J`` times the noise ``noise`` (m per cycle) of
+    the rate the jump extrapolates, random from jump to jump, so the jumps'
+    errors add in quadrature (``variance`` so far, m^2), and the contact
+    relaxes them over ``relax`` cycles (the inverse of its wear per cycle
+    per unit penetration) where the part wears (``wearing``)."""
 
     def total(jump):
         decay = float(np.exp(-jump / relax)) if np.isfinite(relax) and relax > 0.0 else 1.0
-        own = np.where(wearing, decay, 1.0)
-        spread = np.sqrt(variance * own * own + (jump * noise) ** 2)
-        return other + float((error * own + spread).max(initial=0.0))
+        own = np.where(wearing, decay * decay, 1.0)
+        return float(np.sqrt((variance * own + (jump * noise) ** 2).max(initial=0.0)))
 
     return _within(total, tolerance, deepest, fastest, most)
 
@@ -935,26 +925,28 @@ def _wear_fresh(body, s, fresh, wear, normal, work_per_volume):
     s.friction_work[fresh] += work_per_volume * volume
 
 
-def _bodies_relative(js, bodies):
-    """The largest error of depth of the bodies ``bodies`` (states) that is
-    not random (:func:`_after`: a vertex's deterministic one plus the
-    common part), over each one's deepest wear."""
+def _bodies_drift(js, bodies):
+    """The largest drift error of depth of the bodies ``bodies`` (states),
+    a vertex's plus the common part, over each one's deepest wear."""
     out = 0.0
     for k, s in enumerate(bodies):
         deepest = s.wear_depth.max() if len(s.wear_depth) else 0.0
-        if deepest > 0.0 and k < len(js.error):
-            common = _common(js.bias[k]) if k < len(js.bias) else 0.0
-            out = max(out, float((js.error[k].max(initial=0.0) + common) / deepest))
+        if deepest > 0.0 and k < len(js.drift) and len(js.drift[k]):
+            common = abs(float(js.bias[k][0])) if k < len(js.bias) else 0.0
+            out = max(out, float((js.drift[k].max() + common) / deepest))
     return out
 
 
-def _largest(error, variances, k, bias=None):
-    """The largest error of depth (m) of a part: a vertex's deterministic
-    ``error`` plus the root of its variance (``variances[k]``: (n,), or a
-    float of an older checkpoint), plus its common part (``bias[k]``)."""
-    variance = variances[k] if k < len(variances) else 0.0
+def _largest(error, variances, k, drift=None, bias=None):
+    """The largest error of depth (m) of a part: a vertex's step doubling
+    ``error`` and drift's (``drift[k]``) plus the root of its variance
+    (``variances[k]``: (n,), or a float of an older checkpoint), plus its
+    common part (``bias[k]``)."""
+    total = error + np.sqrt(variances[k] if k < len(variances) else 0.0)
+    if drift is not None and k < len(drift) and len(drift[k]) == len(error):
+        total = total + drift[k]
     common = _common(bias[k]) if bias is not None and k < len(bias) else 0.0
-    return float((error + np.sqrt(variance)).max(initial=0.0)) + common
+    return float(total.max(initial=0.0)) + common
 
 
 def error_estimate(state):
@@ -966,11 +958,11 @@ def error_estimate(state):
     for k, (error, s) in enumerate(zip(js.error, state.bodies)):
         deepest = s.wear_depth.max() if len(s.wear_depth) else 0.0
         if deepest > 0.0:
-            worst = max(worst, _largest(error, js.noise_var, k, js.bias) / deepest)
+            worst = max(worst, _largest(error, js.noise_var, k, js.drift, js.bias) / deepest)
     # a worn counter-part, worn by the same contacts, has the bodies'
-    # relative deterministic error besides its own
+    # relative drift error besides its own
     worn = [p.depth for p in state.parts if p is not None]
-    bodies = _bodies_relative(js, state.bodies) if worn else 0.0
+    bodies = _bodies_drift(js, state.bodies) if worn else 0.0
     for k, (error, depth) in enumerate(zip(js.part_error, worn)):
         deepest = depth.max() if len(depth) else 0.0
         if deepest > 0.0:
