@@ -398,13 +398,17 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=
     Bounds: ``end`` (the run ends with a resolved cycle), ``could`` (the
     growth bound the snapshots were taken for, or a forced jump), the drift
     of each vertex's wear per unit penetration over the measurements at
-    this window (:func:`_trend`) and its noise about that drift: their
-    errors (the drift's relaxed by the contact, the noise's random from
-    jump to jump), with the step doubling's so far, within the tolerance of
-    each body's ``deepest`` wear (:func:`_budget_bound`); and step doubling
-    (the jump's estimated error ``<= tol J r_max``). ``t``: the middle of this measurement (cycles).
-    The jump taken adds its drift's error to ``js.drift`` and ``js.bias``,
-    its noise's to ``js.noise_var``."""
+    this window (:func:`_trend`): its error within the tolerance of what the
+    jump adds (``rho_i pbar_i J^2 / 2 <= tol J r_max``) or, with the drift
+    errors of the jumps before as the contact has relaxed them
+    (:func:`_after`), of the body's ``deepest`` wear after the jump; its
+    noise about that drift, random from jump to jump, relaxed alike, within
+    the latter; step doubling (the jump's estimated error ``<= tol J
+    r_max``); and ``keep(results, jump)``, which returns the jump's results
+    with the volume kept (:func:`_keep_volume`) or None where the jump is
+    too long. ``t``: the middle of this measurement (cycles). The jump taken
+    adds its errors to ``js.error`` (step doubling's), ``js.drift``,
+    ``js.noise_var`` and ``js.bias`` (the common part)."""
     fastest = max(float(r.max()) if len(r) else 0.0 for r in rates)
     if forced is not None:
         jump = min(end, could)
