@@ -8,9 +8,12 @@ implicit (default)
     a backward-Euler step in which each vertex's pressure is relieved by its
     own wear and a guided body's load re-balanced (:mod:`meshwear.jumps`):
     stable for any ``J``. ``J`` is the largest one whose error, estimated by
-    step doubling (one jump of ``J`` against two of ``J / 2``) and by the
-    drift of the wear per unit penetration between resolved cycles, stays
-    under ``tolerance`` times the depth the jump adds where wear is fastest;
+    step doubling (one jump of ``J`` against two of ``J / 2``), stays under
+    ``tolerance`` times the depth the jump adds where wear is fastest, and
+    whose drift and noise of the wear per unit penetration between resolved
+    cycles leave errors of depth (each vertex's relaxed by the contact
+    since) within ``tolerance`` of the depth; a body carrying a load along
+    its axis keeps the volume its measurements give (:func:`_keep_volume`);
 explicit
     the cycle's wear times ``J``, ``J`` bounded by the slope criterion (the
     change of each vertex's wear rate between the last two resolved cycles,
