@@ -441,11 +441,12 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=
             # contact has relaxed them, of the depth the body will have
             steep = float(np.abs(drift).max())
             own = 2.0 * tolerance * top[k] / steep
-            budget = _within(lambda j: _drift_total(*_after(js, k, m, drift, noise, j)),
+            budget = _within(lambda j: _drift_total(*_drift_after(js, k, m, drift, j)),
                              tolerance, deepest[k], top[k], most)
             bounds["drift"] = min(bounds.get("drift", np.inf), max(own, float(budget)))
         if noise is not None and noise.any():
-            budget = _within(lambda j: _noise_total(*_after(js, k, m, drift, noise, j)),
+            budget = _within(lambda j: float(np.sqrt(_noise_after(js, k, m, noise, j)
+                                                     .max(initial=0.0))),
                              tolerance, deepest[k], top[k], most)
             bounds["noise"] = min(bounds.get("noise", np.inf), float(budget))
     which = min(bounds, key=bounds.get)
@@ -552,33 +553,43 @@ def _after(js, k, m, drift, noise, jump, doubling=None):
     their part common to the whole contact (its stiffness-weighted mean: a
     guided body's balance takes a uniform error of depth off its move, not
     its wear), which stays."""
-    decay = np.exp(-_relax_rate(m) * jump)
-    drifted = 0.5 * jump * jump * drift
     doubling = np.zeros(len(drift)) if doubling is None else doubling
-    variance = js.noise_var[k][m.index] * decay * decay
-    if noise is not None:
-        variance = variance + (jump * noise) ** 2
+    local, common = _drift_after(js, k, m, drift, jump)
     # the common part: the drift's signed (rates that rise at the contact's
     # edge and fall in its middle keep the volume), step doubling's not
+    common = np.array([common, js.bias[k][1] + _stiffness_mean(m, doubling)])
+    decay = np.exp(-_relax_rate(m) * jump)
+    return (js.error[k][m.index] * decay + doubling, local, _noise_after(js, k, m, noise, jump),
+            common)
+
+
+def _drift_after(js, k, m, drift, jump):
+    """Body ``k``'s drift errors after one more jump (:func:`_after`): (k,)
+    each vertex's, relaxed, and the common part (m, signed)."""
+    drifted = 0.5 * jump * jump * drift
+    local = js.drift[k][m.index] * np.exp(-_relax_rate(m) * jump) + np.abs(drifted)
+    return local, float(js.bias[k][0]) + _stiffness_mean(m, drifted)
+
+
+def _noise_after(js, k, m, noise, jump):
+    """Body ``k``'s noise variance after one more jump (:func:`_after`): (k,)
+    each vertex's, relaxed, plus the jump's (``noise`` None: none)."""
+    decay = np.exp(-_relax_rate(m) * jump)
+    variance = js.noise_var[k][m.index] * decay * decay
+    return variance if noise is None else variance + (jump * noise) ** 2
+
+
+def _stiffness_mean(m, values):
+    """The stiffness-weighted mean of ``values`` (k,) over the vertices of
+    body measure ``m`` in contact (0 with none)."""
     weight = np.where(m.mean > 0.0, m.stiffness, 0.0)
     total = float(weight.sum())
-    common = np.array(js.bias[k], dtype=float)
-    if total > 0.0:
-        common = common + np.array([weight @ drifted, weight @ doubling]) / total
-    return (js.error[k][m.index] * decay + doubling, js.drift[k][m.index] * decay
-            + np.abs(drifted), variance, common)
+    return float(weight @ values) / total if total > 0.0 else 0.0
 
 
-def _drift_total(doubling, drift, variance, common):
-    """The largest drift error of depth (m) of :func:`_after`'s errors, a
-    vertex's and the common part."""
-    return float(drift.max(initial=0.0)) + abs(float(common[0]))
-
-
-def _noise_total(doubling, drift, variance, common):
-    """The largest random error of depth (m) of :func:`_after`'s errors:
-    the root of a vertex's variance."""
-    return float(np.sqrt(variance.max(initial=0.0)))
+def _drift_total(local, common):
+    """The largest drift error of depth (m): a vertex's and the common part."""
+    return float(local.max(initial=0.0)) + abs(common)
 
 
 def _common(bias):
