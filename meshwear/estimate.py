@@ -84,7 +84,8 @@ def estimate_run(model, state=None):
                  per_step=per_step, points=active * max(1, model.slots), active=active,
                  vertices=vertices)
     if model.cycle_steps:
-        e.stepping, e.trial_time, e.trial_covered, e.trial_jumps = _jumping(model, e.stepping)
+        e.stepping, e.trial_time, e.trial_covered, e.trial_jumps = _jumping(
+            model, e.stepping - load)
         e.stepping += load
     return e
 
@@ -173,7 +174,8 @@ def _jumping(model, resolved):
         pass
     elapsed = time.perf_counter() - start
     if state.step >= model.n_steps:
-        return elapsed, elapsed, state.step, state.jump.jumps if state.jump else 0
+        return (min(resolved, elapsed), elapsed, state.step,
+                state.jump.jumps if state.jump else 0)
     n_c = model.cycle_steps
     js = state.jump
     # outputs inside a jump are filled from it: their cost beyond writing

@@ -92,7 +92,7 @@ def balance(depth, beta, stiffness, load):
     b = beta[ok]
     breaks = np.ascontiguousarray(depth[ok] / b)
     weights = np.ascontiguousarray(stiffness[ok] * b * np.abs(b))
-    z = solve(breaks, weights, len(breaks), float(load), 0.0) if len(breaks) else np.nan
+    z = solve(breaks, weights, len(breaks), float(load), 0.0, np.nan) if len(breaks) else np.nan
     return float(z) if np.isfinite(z) else 0.0
 
 

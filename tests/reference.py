@@ -272,8 +272,10 @@ def _walk(y, h, prev, edges, normals, faces, over, tracking, steps):
     """The face a walk from face ``h`` reaches: across the edge the foot of
     ``y`` lies farthest beyond, while the next face shares the edge and its
     normal is within ``tracking`` of ``prev``, until the foot is over a face
-    (``steps`` faces at most)."""
-    f = h
+    (``steps`` faces at most), or over the fold between two faces (its foot
+    beyond their shared edge on both: the walk would go back). Returns the
+    face, and the other face of such a fold (-1: none)."""
+    f, back = h, -1
     for _ in range(steps):
         beyond = edges[f, :, 0:3] @ y - edges[f, :, 3]
         edge = int(np.argmax(beyond))
@@ -281,10 +283,12 @@ def _walk(y, h, prev, edges, normals, faces, over, tracking, steps):
             break
         a, b = faces[f, edge], faces[f, (edge + 1) % 3]
         shared = [g for g in range(len(faces)) if g != f and {a, b} <= set(faces[g].tolist())]
+        if len(shared) == 1 and shared[0] == back:
+            return f, back
         if len(shared) != 1 or normals[shared[0]] @ prev < tracking:
             break
-        f = shared[0]
-    return f
+        f, back = shared[0], f
+    return f, -1
 
 
 def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
@@ -323,8 +327,11 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
         eligible = within & over & (face_normals @ prev >= tracking)
         h = hint[i]
         nearest = pick(within)
-        if tracked and h >= 0 and eligible[h] and not (
-                delta[h] < 0.0 and -delta[h] > release * _inside(tri[h], foot[h])):
+        def released(f):
+            return delta[f] < 0.0 and -delta[f] > release * _to_crease(
+                tri[f], foot[f], faces, f, face_normals, tracking)
+
+        if tracked and h >= 0 and eligible[h] and not released(h):
             kept = h                  # still over the face it had: it stays there
         else:
             kept = -1
@@ -334,10 +341,18 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
                 # it as on its own (not deep under it); else on the nearest
                 # face it can stay on if the walk reached one, or on one as
                 # near as the nearest face
-                f = _walk(y[row], h, prev, edges, face_normals, faces, 1e-9 * reach, tracking,
-                          walk) if h >= 0 else -1
-                if f >= 0 and eligible[f] and not (
-                        delta[f] < 0.0 and -delta[f] > release * _inside(tri[f], foot[f])):
+                f, fold = _walk(y[row], h, prev, edges, face_normals, faces, 1e-9 * reach,
+                                tracking, walk) if h >= 0 else (-1, -1)
+                if fold >= 0:
+                    # over the fold of f and the face the walk came from:
+                    # over both; the nearer, the one whose plane separates
+                    # more if as near
+                    both = np.zeros(F, dtype=bool)
+                    both[[f, fold]] = True
+                    both &= within & (face_normals @ prev >= tracking)
+                    eligible |= both
+                    f = pick(both) if both.any() else f
+                if f >= 0 and eligible[f] and not released(f):
                     kept, onto = f, True
                 elif f >= 0 and eligible[f]:
                     kept = pick(eligible)
@@ -366,12 +381,18 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
         out[i, 2] = motion[1] + np.cross(motion[2], p - motion[3])
 
 
-def _inside(tri, foot):
-    """Distance (>= 0) from a foot inside triangle ``tri`` to its nearest edge line."""
+def _to_crease(tri, foot, faces, f, normals, tracking):
+    """Distance (>= 0) from a foot inside triangle ``tri`` (face ``f``) to its
+    nearest edge line across which no face continues the surface within
+    ``tracking`` (a crease, or a border); inf when there is none."""
     n = np.cross(tri[1] - tri[0], tri[2] - tri[0])
     n /= np.linalg.norm(n)
     out = np.inf
     for k in range(3):
+        a, b = faces[f, k], faces[f, (k + 1) % 3]
+        shared = [g for g in range(len(faces)) if g != f and {a, b} <= set(faces[g].tolist())]
+        if len(shared) == 1 and normals[shared[0]] @ normals[f] >= tracking:
+            continue
         p, q = tri[k], tri[(k + 1) % 3]
         m = np.cross(q - p, n)
         out = min(out, -float((foot - p) @ m) / np.linalg.norm(m))

@@ -147,6 +147,48 @@ def _leaf_faces(boxes, nodes, order, p, reach):
     return listed
 
 
+@pytest.mark.parametrize("start", [0, 1])
+def test_a_vertex_pressed_under_a_fold_between_two_faces_finds_its_face_by_the_walk(start):
+    """Two faces meeting at a shallow valley (a worn flat's faces lean by
+    10^-3 rad): under their shared edge lies a strip whose points have their
+    foot beyond the edge on both faces. A vertex pressed in there, tracked
+    on either face, walks onto the other and finds the edge behind it: it
+    is over both, and takes the one its twin takes (equally near: the one
+    whose plane separates more), without a search: the tree is left empty
+    here (before, the walk went back and forth and only a search found a
+    face; without a tree, none)."""
+    from meshwear.kernels import tree
+
+    # the shared edge along y at x = z = 0; face 0 rises towards -x by 2e-3,
+    # face 1 towards +x by 1e-3; the vertex 1 um under the edge
+    V = np.array([[0.0, -1e-3, 0.0], [0.0, 1e-3, 0.0], [-1e-3, 0.0, 2e-6], [1e-3, 0.0, 1e-6]])
+    F = np.array([[0, 1, 2], [1, 0, 3]], dtype=np.int64)
+    normals = trimesh.Trimesh(V, F, process=False).face_normals.copy()
+    assert (normals[:, 2] > 0.99).all()
+    reach = 1e-4
+    boxes, nodes, order = tree.build(V, F, 1e-12)
+    grid = (np.array([reach, 0.0]), boxes[:0], nodes[:0], order, tree.face_neighbours(F))
+    frames = nearest.face_frames(V, F)
+    body = np.array([[0.0, 0.0, -1e-6]])
+    pose = np.zeros(13)
+    pose[3] = 1.0
+    rotation, motion = np.eye(3), np.zeros((4, 3))
+    beyond = [frames[f, 1:4, 0:3] @ body[0] - frames[f, 1:4, 3] for f in (0, 1)]
+    assert min(b.max() for b in beyond) > 0.0, "the foot must lie beyond the edge on both faces"
+    out = np.zeros((1, 3, 3))
+    out[0, 1] = [0.0, 0.0, 1.0]          # it had a plane: tracked
+    twin_out, distance, twin_distance = out.copy(), np.zeros(1), np.zeros(1)
+    hint, twin_hint = np.full(1, start), np.full(1, start)
+    nearest.nearest_planes(body, pose, np.array([0]), rotation, motion, V, F, frames,
+                           np.zeros((0, 3, 3)), *grid, out, distance, hint)
+    reference.nearest_planes(body, pose, np.array([0]), rotation, motion, V, F, normals,
+                             np.zeros((0, 3, 3)), reach, twin_out, twin_distance, twin_hint)
+    # face 0 leans more, so the vertex under the edge is less deep under its plane
+    assert hint[0] == twin_hint[0] == 0
+    assert _close(out, twin_out) and _close(distance, twin_distance)
+    assert out[0, 1] @ normals[0] == pytest.approx(1.0, abs=1e-15)
+
+
 def test_face_tree_holds_every_face_once_in_boxes_that_hold_them():
     """The properties the kernel's search relies on, on long thin slanted
     triangles (a CAD tessellation): every face in one leaf, each box holding

@@ -14,6 +14,14 @@ solution whenever some pair can push the way the load needs, and a bracketed
 Newton iteration finds it: Newton steps are exact within one linear piece, and
 a step leaving the bracket falls back to bisection, so it never diverges.
 
+Only the pairs that can touch near the answer are iterated on: one pass
+over every pair gives the breakpoints and ``g`` at the guess (the previous
+step's offset), which bounds the answer from one side (``g`` at the guess, or
+a Newton step from it, verified); the pairs that cannot touch beyond that
+bound add nothing there and are set aside before the iteration. A body
+pressed on a curved part has many active vertices within the active set's
+margin but only its contact patch touching: the iteration costs the patch.
+
 Arrays as in :mod:`meshwear.kernels.contact` (``area`` the (n, 4) area vectors,
 ``law`` the contact law; damping plays no part here).
 """
@@ -29,15 +37,18 @@ MAX_ITERATIONS = 200
 
 
 @njit(cache=True)
-def _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law, scale, breakpoint,
-           weight):
+def _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law, scale, guess,
+           breakpoint, weight):
     """Fill ``breakpoint`` (z_j) and ``weight`` (w_j, signed as beta, times
     ``scale[i]`` of its vertex if ``scale`` is not empty) of every pair that
-    can touch; return how many."""
+    can touch; return how many, and g and its slope magnitude at ``guess``
+    (:func:`_force`, in the same pass)."""
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = rotation_entries(pose[3:7])
     c0, c1 = law[5], law[6]
     n_planes = planes.shape[0]
     count = 0
+    g = 0.0
+    slope = 0.0
     for s in range(n_planes + vertex_planes.shape[0]):
         m = s - n_planes
         for k in range(active.shape[0]):
@@ -69,12 +80,48 @@ def _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law, 
             py = pose[1] + r10 * bx + r11 * by + r12 * bz
             pz = pose[2] + r20 * bx + r21 * by + r22 * bz
             delta = (px - ox) * nx + (py - oy) * ny + (pz - oz) * nz
-            breakpoint[count] = -delta / beta
-            weight[count] = c * beta * beta * (1.0 if beta > 0.0 else -1.0)
+            z = -delta / beta
+            w = c * beta * beta * (1.0 if beta > 0.0 else -1.0)
             if scale.shape[0]:
-                weight[count] *= scale[i]
+                w *= scale[i]
+            breakpoint[count] = z
+            weight[count] = w
+            if (w > 0.0 and guess < z) or (w < 0.0 and guess > z):
+                g += abs(w) * (z - guess)
+                slope += abs(w)
             count += 1
-    return count
+    return count, g, slope
+
+
+@njit(cache=True)
+def _near(breakpoint, weight, count, load, guess, g, slope):
+    """Move to the front of ``breakpoint`` and ``weight`` the pairs that can
+    touch on the side of the answer that ``g`` (its value at ``guess``, and
+    its slope magnitude there) bounds, and return how many, with the bound:
+    a ``z`` at which ``g`` is no less (load > 0) or no more (load < 0) than
+    ``load``. The others add nothing on that side. Returns ``count`` and NaN
+    when no such bound is found (the load is zero, or nothing touches at the
+    guess); the pairs are only reordered.
+
+    The bound is the guess itself when ``g`` there already carries the load;
+    else a Newton step from it (exact on the guess's linear piece, beyond
+    the answer where ``g`` is convex), kept only if ``g`` of the pairs kept
+    carries the load there (the others add nothing, so ``g`` does too)."""
+    if load == 0.0 or not (slope > 0.0 or (g - load) * load >= 0.0):
+        return count, np.nan
+    sign = 1.0 if load > 0.0 else -1.0
+    cut = guess if (g - load) * sign >= 0.0 else guess + (g - load) / slope
+    # the pairs pushing the load's way that touch beyond the cut, and every
+    # pair pushing the other way, to the front
+    kept = 0
+    for j in range(count):
+        if weight[j] * sign < 0.0 or (breakpoint[j] - cut) * sign > 0.0:
+            breakpoint[kept], breakpoint[j] = breakpoint[j], breakpoint[kept]
+            weight[kept], weight[j] = weight[j], weight[kept]
+            kept += 1
+    if (_force(cut, breakpoint, weight, kept)[0] - load) * sign < 0.0:
+        return count, np.nan
+    return kept, cut
 
 
 @njit(cache=True)
@@ -108,17 +155,20 @@ def balance_offset(body_vertices, pose, axis, planes, vertex_planes, active, are
     (the faces under the vertices before the move).
     """
     breakpoint, weight = scratch[0], scratch[1]
-    count = _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law, scale,
-                   breakpoint, weight)
-    return solve(breakpoint, weight, count, load, guess)
+    count, g, slope = _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law,
+                             scale, guess, breakpoint, weight)
+    count, bound = _near(breakpoint, weight, count, load, guess, g, slope)
+    return solve(breakpoint, weight, count, load, guess, bound)
 
 
 @njit(cache=True)
-def solve(breakpoint, weight, count, load, guess):
+def solve(breakpoint, weight, count, load, guess, bound):
     """The ``z`` at which ``g(z) = load`` for the first ``count`` pairs of
     ``breakpoint`` (z_j, m) and ``weight`` (w_j, N/m, signed as beta): the
     bracketed Newton iteration of :func:`balance_offset`; NaN when no pair
-    pushes the way the load needs."""
+    pushes the way the load needs. ``bound``, unless NaN, is a ``z`` known
+    to end the bracket on its side (``g`` no less than a positive load
+    there, no more than a negative one)."""
     # the side that must carry the load: pairs pushing along +axis for a
     # positive load (beta > 0), along -axis for a negative one
     edge = np.nan
@@ -137,13 +187,13 @@ def solve(breakpoint, weight, count, load, guess):
     step = max(abs(load) / push, 1e-300)
     if load >= 0.0:
         hi = edge
-        lo = hi - step
+        lo = min(bound, hi) if bound == bound else hi - step
         while _force(lo, breakpoint, weight, count)[0] < load:
             step *= 2.0
             lo = hi - step
     else:
         lo = edge
-        hi = lo + step
+        hi = max(bound, lo) if bound == bound else lo + step
         while _force(hi, breakpoint, weight, count)[0] > load:
             step *= 2.0
             hi = lo + step

@@ -68,7 +68,10 @@ TRACKING = 0.5
 #: times its distance to the edge) or most of the way through a thin plate
 #: (94 %) keeps its face. The check costs a scan only where the vertex is
 #: deeper under its face than this many times the foot's distance to the
-#: face's edges.
+#: face's crease edges (:func:`_to_crease`): an edge to a face that
+#: continues the surface (within TRACKING) is no way in, so a vertex pressed
+#: into a fine flat right over an edge between two of its faces (a body
+#: meshed on the same grid) keeps its face without a search.
 RELEASE = 16.0
 
 #: a vertex is over a face when the foot of it on the face's plane lies in
@@ -121,6 +124,32 @@ def closest_on_triangle(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz):
 def _along(frames, f, row, x, y, z):
     """Signed distance of (x, y, z) past line/plane ``row`` of face ``f``'s frame."""
     return frames[f, row, 0] * x + frames[f, row, 1] * y + frames[f, row, 2] * z - frames[f, row, 3]
+
+
+@njit(cache=True)
+def _to_crease(frames, neighbours, f, x, y, z):
+    """Distance (m) from the foot of (x, y, z) on face ``f``'s plane to the
+    nearest of its edge lines across which the surface turns by more than
+    TRACKING allows (a crease) or ends (a border); inf when it has none."""
+    nearest = np.inf
+    for e in range(3):
+        g = neighbours[f, e]
+        if g >= 0 and (frames[f, 0, 0] * frames[g, 0, 0] + frames[f, 0, 1] * frames[g, 0, 1]
+                       + frames[f, 0, 2] * frames[g, 0, 2]) >= TRACKING:
+            continue
+        nearest = min(nearest, max(-_along(frames, f, e + 1, x, y, z), 0.0))
+    return nearest
+
+
+@njit(cache=True, inline="always")
+def _released(frames, neighbours, f, delta, outside, x, y, z):
+    """A vertex over face ``f`` (``outside`` <= 0: the foot's signed
+    distance past its nearest edge), ``delta`` from its plane, lets go of it
+    (:data:`RELEASE`): deeper under it than RELEASE times its distance to the
+    face's crease edges."""
+    if not (delta < 0.0 and -delta > RELEASE * max(-outside, 0.0)):
+        return False
+    return -delta > RELEASE * _to_crease(frames, neighbours, f, x, y, z)
 
 
 @njit(cache=True)
@@ -226,7 +255,7 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             if (delta * delta <= reach2 and outside <= over
                     and ((fixed and flat)
                          or _along(frames, h, 0, tx, ty, tz) + frames[h, 0, 3] >= TRACKING)
-                    and not (delta < 0.0 and -delta > RELEASE * max(-outside, 0.0))):
+                    and not _released(frames, neighbours, h, delta, outside, yx, yy, yz)):
                 kept, kept_d2, kept_delta = h, delta * delta, delta
                 by_hint = True
         if kept < 0:
@@ -237,6 +266,7 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
                 # farthest beyond, face by face while they keep within
                 # TRACKING, to the face it is over now (WALK faces at most)
                 f = h
+                back, back_beyond = -1, 0.0
                 for _ in range(WALK):
                     edge, beyond = 0, _along(frames, f, 1, yx, yy, yz)
                     for e in range(1, 3):
@@ -250,13 +280,34 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
                             f, yx, yy, yz, frames, faces, counter_vertices, reach2, over, grow,
                             tracked, tx, ty, tz, True, best, best_d2, best_delta, kept, kept_d2,
                             kept_delta)
-                        if (kept == f and not (kept_delta < 0.0
-                                               and -kept_delta > RELEASE * max(-beyond, 0.0))):
+                        if kept == f and not _released(frames, neighbours, f, kept_delta,
+                                                       beyond, yx, yy, yz):
+                            onto = True
+                        break
+                    if neighbours[f, edge] == back:
+                        # over the fold between it and the face it came from:
+                        # two faces at an angle leave a strip along their
+                        # edge (as wide as the vertex's distance times the
+                        # angle: nanometres on a worn flat) whose points have
+                        # their foot beyond the edge on both. There it is
+                        # over both, and takes the nearer (the one whose
+                        # plane separates more, as equally near faces), which
+                        # way it came whatever
+                        for g, past in ((back, back_beyond), (f, beyond)):
+                            best, best_d2, best_delta, kept, kept_d2, kept_delta = _consider(
+                                g, yx, yy, yz, frames, faces, counter_vertices, reach2,
+                                max(over, past), grow, tracked, tx, ty, tz, True, best, best_d2,
+                                best_delta, kept, kept_d2, kept_delta)
+                        if ((kept == f or kept == back)
+                                and not _released(frames, neighbours, kept, kept_delta,
+                                                  back_beyond if kept == back else beyond,
+                                                  yx, yy, yz)):
                             onto = True
                         break
                     g = neighbours[f, edge]
                     if g < 0 or _along(frames, g, 0, tx, ty, tz) + frames[g, 0, 3] < TRACKING:
                         break                   # a border, or a crease it does not follow
+                    back, back_beyond = f, beyond
                     f = g
             walked = kept >= 0
             # the tree's nodes whose boxes come within reach and nearer than
@@ -401,7 +452,8 @@ def nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertic
     had a plane (``out[i]`` nonzero on entry) keeps to faces whose normal is
     within 60 degrees of the one it had while it is over one of them
     (:data:`TRACKING`), and to face ``hint[i]`` itself while it is over it,
-    unless it is :data:`RELEASE` times deeper under it than near another face.
+    unless it is :data:`RELEASE` times deeper under it than near another face
+    (than its distance to the face's crease edges, :func:`_to_crease`).
     ``fixed``: the surface's ``rotation`` is the one of the call that filled
     ``out`` (a fixed or frozen surface), so a vertex that keeps its face
     keeps the normal it holds. ``steady``: such a surface that does not move
