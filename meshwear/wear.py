@@ -906,17 +906,33 @@ def _relaxation(measures):
 
 def _counter_noise(js, k, rate, t):
     """The sampling noise of worn counter-part ``k``'s wear per cycle (V,)
-    (m): each vertex's scatter (:func:`_fit`) of its rate about a straight
-    line through its rates ``rate`` in this measurement (its middle at
-    ``t``, cycles) and the ones before at the same window (its drift taken
-    off: the rates of a contact that widens fall cycle after cycle, and
-    that is no noise). None before three measurements."""
+    (m): each vertex's scatter (:func:`_local_scatter`) of its rate
+    ``rate`` in this measurement (its middle at ``t``, cycles) and the ones
+    before at the same window about their trend (the rates of a contact
+    that widens fall cycle after cycle, and those of a vertex it reaches
+    rise to their own: that is no noise). None before three measurements."""
     past = [(time, rates[k]) for time, _, rates in js.history if rates[k] is not None]
     if len(past) < 2:
         return None
-    _, sigma = _fit(np.array([time for time, _ in past] + [t]),
-                    np.vstack([r for _, r in past] + [rate]))
-    return sigma
+    return _local_scatter(np.array([time for time, _ in past] + [t]),
+                          np.vstack([r for _, r in past] + [rate]))
+
+
+def _local_scatter(times, values):
+    """(n,) the scatter of each column of ``values`` (K, n; K >= 3) measured
+    at ``times`` (K,, increasing) about a trend that need not be a straight
+    line: each inner measurement's distance from the line through its two
+    neighbours, over the spread that distance has for independent
+    measurements of one scatter (1 + a^2 + b^2 its variance, a and b the
+    neighbours' weights), in quadrature over the inner measurements. A
+    straight line through all of them (:func:`_fit`) would count as noise
+    the bend of a trend over the measurements' span: a counter vertex that
+    the widening contact reaches has its wear per cycle rise over tens of
+    cycles and settle, and the measurements, a jump apart, span hundreds."""
+    t0, t1, t2 = times[:-2], times[1:-1], times[2:]
+    a, b = ((t2 - t1) / (t2 - t0))[:, None], ((t1 - t0) / (t2 - t0))[:, None]
+    off = values[1:-1] - a * values[:-2] - b * values[2:]
+    return np.sqrt((off * off / (1.0 + a * a + b * b)).mean(axis=0))
 
 
 #: the arrays of a worn counter-part a jump extrapolates

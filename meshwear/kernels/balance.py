@@ -106,11 +106,16 @@ def _near(breakpoint, weight, count, load, guess, g, slope):
     The bound is the guess itself when ``g`` there already carries the load;
     else a Newton step from it (exact on the guess's linear piece, beyond
     the answer where ``g`` is convex), kept only if ``g`` of the pairs kept
-    carries the load there (the others add nothing, so ``g`` does too)."""
-    if load == 0.0 or not (slope > 0.0 or (g - load) * load >= 0.0):
+    carries the load there (the others add nothing, so ``g`` does too).
+    Either is taken a little short (10^-9 of the load's whole compliance),
+    so that the rounding of the sums does not refuse it."""
+    if load == 0.0 or not slope > 0.0:
         return count, np.nan
     sign = 1.0 if load > 0.0 else -1.0
     cut = guess if (g - load) * sign >= 0.0 else guess + (g - load) / slope
+    # a little short of it, where g carries the load whatever the rounding of
+    # the sums (a Newton step from the answer's own piece lands on it)
+    cut -= sign * (1e-9 * abs(load) / slope + 1e-6 * abs(cut - guess))
     # the pairs pushing the load's way that touch beyond the cut, and every
     # pair pushing the other way, to the front
     kept = 0

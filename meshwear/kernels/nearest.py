@@ -152,7 +152,7 @@ def _released(frames, neighbours, f, delta, outside, x, y, z):
     return -delta > RELEASE * _to_crease(frames, neighbours, f, x, y, z)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _consider(f, yx, yy, yz, frames, faces, counter_vertices, reach2, over, grow, tracked,
               tx, ty, tz, walked, best, best_d2, best_delta, kept, kept_d2, kept_delta):
     """Face ``f`` against the nearest face so far (best) and the nearest the
