@@ -851,9 +851,13 @@ def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None, 
         part.depth += scale * rate
         part.volume += scale / window * (part.volume - volume0)
         part.work += scale / window * (part.work - work0)
-        part.vertices[:] = (surface.reference_vertices
-                            - part.depth[:, None] * surface.vertex_normals)
-        part.frames[:] = face_frames(part.vertices, surface.faces)
+        moved = scale * rate != 0.0
+        part.vertices[moved] = (surface.reference_vertices[moved]
+                                - part.depth[moved, None] * surface.vertex_normals[moved])
+        # the faces round the vertices the jump moved get their frames again
+        # (a fine flat's scar is a few per cent of its faces)
+        around = moved[surface.faces].any(axis=1)
+        part.frames[around] = face_frames(part.vertices, surface.faces[around])
         surface.rebin()
         previous = js.part_rate[k]
         # the errors so far relax where the part wears (implicit jumps:
