@@ -63,7 +63,9 @@ def contact_geometry(model, body, s, index):
     rows = [(np.broadcast_to(p[0:2], (n, 2, 3)), True) for p in model.planes]
     # a mesh surface's plane rows are kept for the vertices within reach only
     # (the others' are stale)
-    reach = np.isin(index, s.active)
+    within = np.zeros(len(s.wear_depth), dtype=bool)
+    within[s.active] = True
+    reach = within[index]
     rows += [(vp[index, 0:2], reach) for vp in s.vertex_planes]
     for row, valid in rows:
         point, nrm = row[:, 0], row[:, 1]
@@ -152,7 +154,9 @@ def measure(model, body, s, rate, start=None, window=1):
     steady contact (a pin, a fretting ball) that is the end penetration; in
     one that sweeps over the vertex (a gear flank) the kinematics are
     periodic and only the wear and moves change it."""
-    index = np.union1d(s.active, np.flatnonzero(rate > 0.0)).astype(np.int64)
+    chosen = rate > 0.0
+    chosen[s.active] = True
+    index = np.flatnonzero(chosen).astype(np.int64)    # sorted, as a union of both
     rate = rate[index]
     depth, normal, stiffness = contact_geometry(model, body, s, index)
     force, square = s.load[0, index], s.load[1, index]
