@@ -93,7 +93,7 @@ def _pairs(body_vertices, pose, axis, planes, vertex_planes, active, area, law, 
     return count, g, slope
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _near(breakpoint, weight, count, load, guess, g, slope):
     """Move to the front of ``breakpoint`` and ``weight`` the pairs that can
     touch on the side of the answer that ``g`` (its value at ``guess``, and
