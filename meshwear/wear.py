@@ -637,17 +637,23 @@ def _relax_resolved(js, measures, part_rates, window):
             js.noise_var[k][m.index] *= decay * decay
             if k < len(js.drift) and len(js.drift[k]):
                 js.drift[k][m.index] *= decay
-    decay = _part_decay(js, window)
     for k, rate in enumerate(part_rates):
-        wearing = rate > 0.0
-        js.part_error[k][wearing] *= decay
-        js.part_noise_var[k][wearing] *= decay * decay
+        _relax_part(js, k, rate > 0.0, window)
 
 
-def _part_decay(js, cycles):
+def _relax_part(js, k, wearing, cycles):
+    """Relax worn counter-part ``k``'s errors of depth so far over
+    ``cycles`` cycles at its vertices ``wearing`` (mask)."""
+    decay = _decay(cycles, js.relax)
+    js.part_error[k][wearing] *= decay
+    js.part_noise_var[k][wearing] *= decay * decay
+
+
+def _decay(cycles, relax):
     """The factor by which a worn counter-part's errors of depth relax over
-    ``cycles`` cycles where it wears (over ``js.relax``, the contact's)."""
-    return float(np.exp(-cycles / js.relax)) if np.isfinite(js.relax) and js.relax > 0 else 1.0
+    ``cycles`` cycles where it wears (``relax``: the contact's time, cycles;
+    inf or 0: none)."""
+    return float(np.exp(-cycles / relax)) if np.isfinite(relax) and relax > 0 else 1.0
 
 
 def _trend(m, past, t):
@@ -862,10 +868,7 @@ def _jump_parts(model, parts, before_parts, part_rates, js, jump, factors=None, 
         previous = js.part_rate[k]
         # the errors so far relax where the part wears (implicit jumps:
         # js.relax is the contact's time; explicit, none)
-        wearing = rate > 0.0
-        decay = _part_decay(js, jump)
-        js.part_error[k][wearing] *= decay
-        js.part_noise_var[k][wearing] *= decay * decay
+        _relax_part(js, k, rate > 0.0, jump)
         if relative is not None:
             js.part_error[k] += jump * rate * relative      # the bodies' implicit step's
         else:
@@ -889,7 +892,7 @@ def _noise_bound(noise, variance, wearing, tolerance, deepest, fastest, relax, m
     per unit penetration) where the part wears (``wearing``)."""
 
     def total(jump):
-        decay = float(np.exp(-jump / relax)) if np.isfinite(relax) and relax > 0.0 else 1.0
+        decay = _decay(jump, relax)
         own = np.where(wearing, decay * decay, 1.0)
         return float(np.sqrt((variance * own + (jump * noise) ** 2).max(initial=0.0)))
 
