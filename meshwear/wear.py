@@ -69,6 +69,11 @@ NOISY = ("noise", "counter noise")
 #: refuse lets the contact relax them, and the jumps after it grow from the
 #: last one taken, not from one again
 BUDGET = ("drift", "noise", "counter noise")
+#: the refusals after which the jumps grow on from the last one taken: the
+#: budget's, and the volume's (the implicit step misses the measured volume
+#: at every length down to one cycle: what was measured is the transient a
+#: long jump leaves, penetrations still settling, and the next cycle is not)
+RESUME = BUDGET + ("volume",)
 #: measurements (this one included) a vertex's drift and noise are fitted over
 HISTORY = 8
 
@@ -331,8 +336,7 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
             js.jumps += 1
             js.taken.append((stop / n_c, jump, which))
             js.settling = not model.quasi_static
-        if jump > 0 or which not in BUDGET:
-            js.last_jump = jump
+        js.last_jump = _grows_from(jump, which, js.last_jump)
         if jump == 0:
             js.last_limit = which        # why none was taken (the progress line says)
         js.rate = rates
@@ -362,6 +366,14 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
         if checkpoint is not None:
             checkpoint(model, state)
     return state
+
+
+def _grows_from(jump, which, last):
+    """The jump the next one may grow from (:data:`GROWTH`), after this
+    measurement's ``jump`` (0: refused) set by ``which``: the one taken; or,
+    refused by a bound a resolved cycle mends (:data:`RESUME`), the last
+    one taken; else none (growth starts again from one cycle)."""
+    return jump if jump > 0 or which not in RESUME else last
 
 
 def _progress(measures, results, jump):
@@ -445,9 +457,10 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=
                              tolerance, deepest[k], top[k], most)
             bounds["drift"] = min(bounds.get("drift", np.inf), max(own, float(budget)))
         if noise is not None and noise.any():
-            budget = _within(lambda j: float(np.sqrt(_noise_after(js, k, m, noise, j)
-                                                     .max(initial=0.0))),
-                             tolerance, deepest[k], top[k], most)
+            still = _relax_rate(m) <= 0.0
+            budget = _within(lambda j: float(np.sqrt(_settled(
+                _noise_after(js, k, m, noise, j), still, tolerance, deepest[k])
+                .max(initial=0.0))), tolerance, deepest[k], top[k], most)
             bounds["noise"] = min(bounds.get("noise", np.inf), float(budget))
     which = min(bounds, key=bounds.get)
     jump = int(np.floor(bounds[which]))
@@ -889,14 +902,37 @@ def _noise_bound(noise, variance, wearing, tolerance, deepest, fastest, relax, m
     the rate the jump extrapolates, random from jump to jump, so the jumps'
     errors add in quadrature (``variance`` so far, m^2), and the contact
     relaxes them over ``relax`` cycles (the inverse of its wear per cycle
-    per unit penetration) where the part wears (``wearing``)."""
+    per unit penetration) where the part wears (``wearing``).
+
+    Where the part does not wear, its errors so far stay as they are: no
+    resolved cycle relaxes them, so waiting cannot bring one over the
+    tolerance back within it (a vertex the scar's edge has left, its
+    error admitted against a depth the jump did not quite reach), and
+    such a vertex counts its errors so far up to the tolerance of today's
+    depth only (:func:`_settled`); the jump adds to them its noise, if it
+    has any."""
+    frozen = _settled(np.where(wearing, 0.0, variance), ~wearing, tolerance, deepest)
 
     def total(jump):
         decay = _decay(jump, relax)
-        own = np.where(wearing, decay * decay, 1.0)
-        return float(np.sqrt((variance * own + (jump * noise) ** 2).max(initial=0.0)))
+        kept = np.where(wearing, variance * decay * decay, frozen)
+        return float(np.sqrt((kept + (jump * noise) ** 2).max(initial=0.0)))
 
     return _within(total, tolerance, deepest, fastest, most)
+
+
+def _settled(variance, still, tolerance, deepest):
+    """``variance`` (m^2) of the random errors of depth, each of the
+    vertices ``still`` (mask: out of contact, no resolved cycle relaxes
+    them) counted up to the tolerance of today's depth ``deepest`` only.
+
+    A jump's errors are admitted against the depth it plans (``deepest + J
+    r``); where it deepens less (a contact's transient after a jump reads a
+    faster ``r``) a vertex can be left over the tolerance, and once the
+    contact has left it, refusing jumps cannot mend its error: held by it,
+    a fretting run resolved 400 cycles in a row. The error itself stays
+    in the estimate (:func:`error_estimate`)."""
+    return np.where(still, np.minimum(variance, (tolerance * deepest) ** 2), variance)
 
 
 def _relaxation(measures):

@@ -571,6 +571,32 @@ def test_a_counter_vertex_the_contact_reaches_settles_without_noise():
     assert _local_scatter(times, noisy)[0] == pytest.approx(0.1e-9, rel=0.15)
 
 
+def test_an_error_the_contact_has_left_over_the_tolerance_does_not_refuse_every_jump():
+    """A counter vertex the scar's edge has left keeps its random error of
+    depth (no resolved cycle relaxes it). Admitted against the depth a jump
+    planned but did not quite reach, it can stand over the tolerance of
+    today's depth; refusing jumps cannot mend it (the fretting example
+    resolved 400 cycles in a row, held by one such vertex). It counts up to
+    that tolerance: a jump that adds nothing to it passes, one that adds
+    its noise is bounded, and a wearing vertex over it still refuses (the
+    resolved cycles relax it)."""
+    from meshwear.wear import _noise_bound
+
+    tol, deepest, fastest, relax = 0.01, 3.2e-6, 5e-10, 300.0
+    over = (1.1 * tol * deepest) ** 2
+    wearing = np.array([True, False])          # the contact has left the second
+    quiet = np.zeros(2)
+    assert _noise_bound(quiet, np.array([0.0, over]), wearing, tol, deepest, fastest, relax,
+                        200) == 200
+    noisy = np.array([0.0, 0.5 * fastest])
+    bound = _noise_bound(noisy, np.array([0.0, over]), wearing, tol, deepest, fastest, relax, 200)
+    # tol (D + J r) >= sqrt((tol D)^2 + (J sigma)^2): J <= 2 tol^2 D r / (sigma^2 - tol^2 r^2)
+    most = 2 * tol * tol * deepest * fastest / ((0.5 * fastest) ** 2 - (tol * fastest) ** 2)
+    assert 3 <= 0.8 * most - 1 <= bound <= most
+    assert _noise_bound(quiet, np.array([(3 * tol * deepest) ** 2, 0.0]), wearing, tol, deepest,
+                        fastest, relax, 200) == 0
+
+
 def test_a_worn_surface_s_tree_is_fitted_anew_only_once_its_wear_passes_the_slack(tmp_path):
     """A worn counter mesh grows its tree's boxes by a slack: while no vertex
     has sunk farther than that since they were fitted (the gear pair's

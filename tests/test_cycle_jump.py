@@ -10,7 +10,7 @@ import cases
 from meshwear.model import build_model, initial_state
 from meshwear.scene import load_scene
 from meshwear.simulate import run, run_scene
-from meshwear.wear import GROWTH, THETA, choose_jump, error_estimate
+from meshwear.wear import GROWTH, THETA, _grows_from, choose_jump, error_estimate
 
 
 # ---------------------------------------------------------------- controller
@@ -44,6 +44,21 @@ def test_growth_and_end_bounds():
     steady = dict(previous=rate.copy(), gap=1.0, penetration_=np.full(3, 1.0), tolerance=0.01)
     assert choose_jump(rate, last_jump=7, limit=10_000, **steady) == (int(GROWTH * 7 + 1), "growth")
     assert choose_jump(rate, last_jump=7, limit=3, **steady) == (3, "end")
+
+
+def test_jumps_grow_on_after_a_cycle_that_measured_a_transient():
+    """A measurement refused by a bound the next resolved cycle mends lets
+    the jumps after it grow from the last one taken: the budget's (the
+    cycle relaxes the errors so far) and the volume's (right after a long
+    jump the implicit step missed the measured volume at every length down
+    to one cycle, and the cycle after it did not: on the fretting example
+    growth started again from one cycle after every 255-cycle try, 1, 3, 7,
+    ..., 127, 35 times). Any other refusal starts growth again from one."""
+    assert _grows_from(0, "volume", 127) == 127
+    assert _grows_from(0, "counter noise", 127) == 127
+    assert _grows_from(0, "accuracy", 127) == 0
+    assert _grows_from(0, "counter accuracy", 127) == 0
+    assert _grows_from(9, "volume", 127) == 9
 
 
 def test_implicit_jumps_have_no_stability_bound():
