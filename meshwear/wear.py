@@ -458,9 +458,9 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=
             bounds["drift"] = min(bounds.get("drift", np.inf), max(own, float(budget)))
         if noise is not None and noise.any():
             still = _relax_rate(m) <= 0.0
-            budget = _within(lambda j: float(np.sqrt(_settled(
-                _noise_after(js, k, m, noise, j), still, tolerance, deepest[k])
-                .max(initial=0.0))), tolerance, deepest[k], top[k], most)
+            budget = _within(lambda j: float(np.sqrt((_settled(
+                _noise_after(js, k, m, None, j), still, tolerance, deepest[k])
+                + (j * noise) ** 2).max(initial=0.0))), tolerance, deepest[k], top[k], most)
             bounds["noise"] = min(bounds.get("noise", np.inf), float(budget))
     which = min(bounds, key=bounds.get)
     jump = int(np.floor(bounds[which]))
@@ -930,7 +930,7 @@ def _settled(variance, still, tolerance, deepest):
     r``); where it deepens less (a contact's transient after a jump reads a
     faster ``r``) a vertex can be left over the tolerance, and once the
     contact has left it, refusing jumps cannot mend its error: held by it,
-    a fretting run resolved 400 cycles in a row. The error itself stays
+    a fretting run resolved 396 cycles in a row. The error itself stays
     in the estimate (:func:`error_estimate`)."""
     return np.where(still, np.minimum(variance, (tolerance * deepest) ** 2), variance)
 

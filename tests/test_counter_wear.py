@@ -576,7 +576,7 @@ def test_an_error_the_contact_has_left_over_the_tolerance_does_not_refuse_every_
     depth (no resolved cycle relaxes it). Admitted against the depth a jump
     planned but did not quite reach, it can stand over the tolerance of
     today's depth; refusing jumps cannot mend it (the fretting example
-    resolved 400 cycles in a row, held by one such vertex). It counts up to
+    resolved 396 cycles in a row, held by one such vertex). It counts up to
     that tolerance: a jump that adds nothing to it passes, one that adds
     its noise is bounded, and a wearing vertex over it still refuses (the
     resolved cycles relax it)."""
