@@ -263,16 +263,19 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
         middle = state.step / n_c - 0.5 * window
         for k, rate in enumerate(part_rates):
             js.part_noise[k] = _counter_noise(js, k, rate, middle)
-        js.relax = _relaxation(measures)
-        _relax_resolved(js, measures, part_rates, window)
-        js.noisy = False
-        part_limit, part_which = float("inf"), None
         if parts:
+            # (before the relaxation: the counter-part's wear under each
+            # body vertex relaxes its errors too, gamma_i)
             increments = [None] * len(state.parts)
             for (j, _), rate in zip(parts, part_rates):
                 increments[j] = rate
             for s, m in zip(state.bodies, measures):
                 jumps.counter_relief(model, s, m, increments, state.time)
+        js.relax = _relaxation(measures)
+        _relax_resolved(js, measures, part_rates, window)
+        js.noisy = False
+        part_limit, part_which = float("inf"), None
+        if parts:
             if forced_jump is None:
                 part_limit, part_which = _part_limit(model, parts, part_rates, js, measures,
                                                      tolerance, end_limit, implicit,
@@ -940,8 +943,8 @@ def _relaxation(measures):
     inverse of the median, over the vertices in contact, of their own and
     their counter-part's wear per cycle per unit penetration); inf when
     nothing wears."""
-    rates = [(m.alpha if m.gamma is None else m.alpha + m.gamma)[m.member & (m.alpha > 0.0)]
-             for m in measures or ()]
+    rates = [(m.alpha if m.gamma is None else m.alpha + m.gamma)[
+        m.member & (m.alpha > 0.0) & (m.mean > 0.0)] for m in measures or ()]
     rates = np.concatenate(rates) if rates else np.zeros(0)
     middle = float(np.median(rates)) if len(rates) else 0.0
     return 1.0 / middle if middle > 0.0 else np.inf

@@ -256,6 +256,35 @@ def test_cycle_jumps_carry_both_parts_wear(ten_turns, measured):
                         tolerance) <= tolerance
 
 
+def test_a_worn_counter_part_s_errors_relax_at_both_parts_wear(tmp_path, monkeypatch):
+    """An error of depth relaxes at the body vertex's own and its worn
+    counter-part's wear per cycle per unit penetration, alpha + gamma
+    (docs/model.md, "Long durations"), over the resolved cycles too, and the
+    counter-part's own errors at the median of those: each measurement
+    knows the counter's wear under its vertices (gamma) before the
+    relaxation is taken (it was taken before, from alpha alone: on the
+    fretting example the flat's errors relaxed over 260 cycles where the
+    contact relaxes them over about half that)."""
+    from meshwear import wear
+
+    seen = []
+    relaxation = wear._relaxation
+
+    def spy(measures):
+        out = relaxation(measures)
+        m = measures[0]
+        on = m.member & (m.alpha > 0.0)
+        seen.append((m.gamma is not None, out, 1.0 / np.median(m.alpha[on])))
+        return out
+
+    monkeypatch.setattr(wear, "_relaxation", spy)
+    model = build_model(load_scene(_jumped(tmp_path, 6)))
+    run(model, initial_state(model))
+    assert len(seen) >= 2
+    assert all(known for known, _, _ in seen)
+    assert all(relax < 0.9 * alone for _, relax, alone in seen)
+
+
 def test_every_history_row_of_a_jumped_run_has_both_parts_forces_balance(tmp_path):
     """Rows filled from a jump carry the resolved cycle's contact at the same
     phase for the worn disc too: in every row, resolved or filled, the pin's
