@@ -914,7 +914,7 @@ def _noise_bound(noise, variance, wearing, tolerance, deepest, fastest, relax, m
     such a vertex counts its errors so far up to the tolerance of today's
     depth only (:func:`_settled`); the jump adds to them its noise, if it
     has any."""
-    frozen = _settled(np.where(wearing, 0.0, variance), ~wearing, tolerance, deepest)
+    frozen = _settled(variance, ~wearing, tolerance, deepest)
 
     def total(jump):
         decay = _decay(jump, relax)
