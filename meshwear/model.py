@@ -16,7 +16,7 @@ from .dynamics import OwnMotions
 from .elastic import HalfSpace, PatchError
 from .elastic import step as elastic_step
 from .kernels.contact import LAW_SLOTS, all_vertices, contact, make_law, rotation_entries
-from .kernels.counter_wear import wear_counter
+from .kernels.counter_wear import settle_counter, wear_counter
 from .kernels.laws import code_of
 from .kernels.nearest import face_frames
 from .motion import (BalancedMotion, FixedMotion, FreeMotion, GuidedMotion, MechanismMotion, Path,
@@ -226,9 +226,11 @@ class PartState:
         Their faces' frames (:func:`meshwear.kernels.nearest.face_frames`).
     depth, volume, work : (V,) float
         Wear depth (m), worn volume (m³) and friction work (J) per vertex.
-    added : (V,) float, touched : (V,) int64
-        Scratch of :func:`meshwear.kernels.counter_wear.wear_counter` (``added``
-        zeros between steps).
+    added : (V,) float, touched : (V,) int64, limit : (V,) float, due : (V,) int64, count : (1,) int64
+        Each vertex's lag (the depth it took since it last moved), the
+        lagging vertices (``count`` of them), the lag at which each moves and
+        scratch (:func:`meshwear.kernels.counter_wear.wear_counter`); none lag
+        between two stretches of steps (:func:`settle_counters`).
     """
 
     vertices: np.ndarray
@@ -238,6 +240,9 @@ class PartState:
     work: np.ndarray
     added: np.ndarray
     touched: np.ndarray
+    limit: np.ndarray
+    due: np.ndarray
+    count: np.ndarray
 
     @classmethod
     def unworn(cls, surface):
@@ -245,7 +250,8 @@ class PartState:
         return cls(vertices=surface.reference_vertices.copy(),
                    frames=face_frames(surface.reference_vertices, surface.faces),
                    depth=np.zeros(n), volume=np.zeros(n), work=np.zeros(n), added=np.zeros(n),
-                   touched=np.zeros(n, np.int64))
+                   touched=np.zeros(n, np.int64), limit=np.full(n, np.inf),
+                   due=np.zeros(n, np.int64), count=np.zeros(1, np.int64))
 
 
 @dataclass(eq=False)
@@ -750,6 +756,14 @@ def body_contact(model, body, s, law=None):
             model.law if law is None else law, body.wear_direction, s.contact_state,
             s.tangential, s.normal_force, s.friction_work, s.wear_depth, s.wear_volume,
             s.wrench)
+
+
+def settle_counters(model):
+    """Move every lagging vertex of the worn counter-surfaces to its depth
+    (:func:`meshwear.kernels.counter_wear.settle_counter`)."""
+    for surface in model.surfaces.per_vertex:
+        if surface.worn and surface.part is not None:
+            settle_counter(surface.part_tuple())
 
 
 def wear_counters(model, body, s, t, pairs=None):

@@ -18,7 +18,7 @@ import numpy as np
 from . import elastic, stepper, surfaces
 from .geometry import inverted_faces
 from .kernels.loop import deepest_penetration, impact_check, use_impact_room
-from .model import IMPACT_DEPTH, body_contact, wear_counters
+from .model import IMPACT_DEPTH, body_contact, settle_counters, wear_counters
 from .output.memory import MemoryHistory
 from .wear import run_cycle_jump
 
@@ -214,6 +214,9 @@ def advance(model, state, stop, observers=(), progress=None, checkpoint=None, co
             stepper.advance(model, state, until)
         while state.step < until:
             step(model, state)
+        # (outputs, checkpoints and jumps see the counter-parts where their
+        # depths put them)
+        settle_counters(model)
         state.resolved = True
         if progress is not None:
             progress(state.step, model.n_steps)

@@ -12,6 +12,10 @@ import numpy as np
 from meshwear.kernels.laws import LAWS
 
 NO_CONTACT, STICK, SLIP = 0, 1, 2
+
+#: a worn counter vertex moves once its lag reaches this fraction of the
+#: smallest penetration of the pairs that wore it since (docs/model.md)
+LAG_FRACTION = 1e-2
 #: law code -> numpy twin of its increment (the twins live beside the
 #: increments in the registry; the kernel's dispatch on codes is what this
 #: checks)
@@ -459,9 +463,10 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
     array at a time (the pairs' energy and slip from their velocities, the
     law's twin, the closest-point weights of :func:`closest_points`); the
     face frames are all recomputed. Returns the vertices that sank more than
-    half their spacing."""
+    half their spacing since they last moved (the kernel returns the first
+    of them)."""
     (counter_law, faces, reference, normals, tributary, spacing, _, _, vertices, frames, depth,
-     volume, work, _, _) = part
+     volume, work, added, _, limit, _, _) = part
     code, k = int(counter_law[0]), counter_law[1]
     f, dt, dt0, dt1 = law[0], law[4], law[11], law[12]
     R = quaternion_matrix(pose[3:7])
@@ -470,9 +475,11 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
     n = planes[i, 1]
     r = body_vertices[i] @ R.T
     x = pose[0:3] + r
-    foot = x - _dot(x - planes[i, 0], n)[:, None] * n
+    delta = _dot(x - planes[i, 0], n)
+    foot = x - delta[:, None] * n
     a = contact_areas(area_vectors[i], R, n)
-    i, n, r, foot, a = i[a > 0.0], n[a > 0.0], r[a > 0.0], foot[a > 0.0], a[a > 0.0]
+    keep = a > 0.0
+    i, n, r, foot, a, delta = i[keep], n[keep], r[keep], foot[keep], a[keep], delta[keep]
     g = pose[7:10] + np.cross(pose[10:13], r) - planes[i, 2]
     s = g - _dot(g, n)[:, None] * n
     speed = np.linalg.norm(s, axis=1)
@@ -488,10 +495,30 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
         np.add.at(work, corners[:, c], weights[:, c] * energy)
         np.add.at(volume, corners[:, c], weights[:, c] * dv)
         np.add.at(depth, corners[:, c], weights[:, c] * dv / tributary[corners[:, c]])
-    moved = depth > before
+        # a vertex moves once its lag reaches LAG_FRACTION of the smallest
+        # penetration of the pairs that wore it since it last moved
+        wore = (weights[:, c] > 0.0) & (dv > 0.0)
+        np.minimum.at(limit, corners[wore, c],
+                      LAG_FRACTION * np.minimum(-delta[wore], spacing[corners[wore, c]]))
+    added += depth - before
+    deep = np.flatnonzero(added > 0.5 * spacing)
+    moved = (added > 0.0) & (added >= limit)
     vertices[moved] = reference[moved] - depth[moved, None] * normals[moved]
+    added[moved] = 0.0
+    limit[moved] = np.inf
     frames[...] = face_frames(vertices, faces)
-    return np.flatnonzero(depth - before > 0.5 * spacing)
+    return deep
+
+
+def settle_counter(part):
+    """Twin of :func:`meshwear.kernels.counter_wear.settle_counter`."""
+    (_, faces, reference, normals, _, _, _, _, vertices, frames, depth, _, _, added, _, limit,
+     _, _) = part
+    moved = added > 0.0
+    vertices[moved] = reference[moved] - depth[moved, None] * normals[moved]
+    added[moved] = 0.0
+    limit[moved] = np.inf
+    frames[...] = face_frames(vertices, faces)
 
 
 def face_frames(vertices, faces):

@@ -14,7 +14,7 @@ import cases
 import reference
 from meshwear import checkpoint
 from meshwear.cli import main
-from meshwear.kernels.counter_wear import wear_counter
+from meshwear.kernels.counter_wear import settle_counter, wear_counter
 from meshwear.model import build_model, initial_state
 from meshwear.scene import SceneError, load_scene
 from meshwear.simulate import NumericalError, run
@@ -83,19 +83,49 @@ def test_kernel_matches_its_numpy_twin(tmp_path):
     args = (s.vertices, s.pose, s.active, body.area_vectors, model.law, s.contact_state[0],
             s.normal_force[0], s.vertex_planes[0], s.hint[0], rotation, frame)
     depth0 = part.depth.copy()
-    assert wear_counter(*args, disc.part_tuple()) == -1
     twin_tuple = (disc.law, disc.faces, disc.reference_vertices, disc.vertex_normals,
                   disc.tributary, disc.spacing, None, None, twin.vertices, twin.frames,
-                  twin.depth, twin.volume, twin.work, twin.added, twin.touched)
-    assert len(reference.wear_counter(*args, twin_tuple)) == 0
+                  twin.depth, twin.volume, twin.work, twin.added, twin.touched, twin.limit,
+                  twin.due, twin.count)
+
+    def same():
+        for name in ("depth", "volume", "work", "vertices", "added", "limit"):
+            np.testing.assert_allclose(getattr(part, name), getattr(twin, name), rtol=1e-12,
+                                       atol=1e-12 * np.abs(getattr(twin, name)).max(
+                                           where=np.isfinite(getattr(twin, name)),
+                                           initial=0.0))
+        touched = np.unique(disc.faces[np.isin(disc.faces, np.flatnonzero(part.depth > depth0))
+                                       .any(axis=1)].ravel())
+        faces = np.flatnonzero(np.isin(disc.faces, touched).any(axis=1))
+        np.testing.assert_allclose(part.frames[faces], twin.frames[faces], rtol=0, atol=1e-12)
+
+    # the same step taken over and over: vertices lag, then move once their
+    # lag reaches LAG_FRACTION of their pairs' penetration
+    lagged = moved = False
+    for _ in range(400):
+        assert wear_counter(*args, disc.part_tuple()) == -1
+        assert len(reference.wear_counter(*args, twin_tuple)) == 0
+        same()
+        lagging = part.added > 0.0
+        lagged |= lagging.any()
+        at_depth = np.all(part.vertices == disc.reference_vertices
+                          - part.depth[:, None] * disc.vertex_normals, axis=1)
+        moved |= (at_depth & (part.depth > depth0)).any()
+        # a lagging vertex is where its depth less its lag puts it
+        np.testing.assert_allclose(part.vertices[lagging], disc.reference_vertices[lagging]
+                                   - (part.depth - part.added)[lagging, None]
+                                   * disc.vertex_normals[lagging], rtol=0, atol=1e-15)
+        assert set(part.touched[:part.count[0]]) == set(np.flatnonzero(lagging))
+        if lagged and moved:
+            break
     assert (part.depth > depth0).sum() > 10
-    for name in ("depth", "volume", "work", "vertices"):
-        np.testing.assert_allclose(getattr(part, name), getattr(twin, name), rtol=1e-12,
-                                   atol=1e-12 * np.abs(getattr(twin, name)).max())
-    touched = np.unique(disc.faces[np.isin(disc.faces, np.flatnonzero(part.depth > depth0))
-                                   .any(axis=1)].ravel())
-    faces = np.flatnonzero(np.isin(disc.faces, touched).any(axis=1))
-    np.testing.assert_allclose(part.frames[faces], twin.frames[faces], rtol=0, atol=1e-12)
+    assert lagged and moved, "the case must have vertices that lag and that move"
+    settle_counter(disc.part_tuple())
+    reference.settle_counter(twin_tuple)
+    same()
+    assert part.count[0] == 0 and not part.added.any() and np.isinf(part.limit).all()
+    np.testing.assert_allclose(part.vertices, disc.reference_vertices
+                               - part.depth[:, None] * disc.vertex_normals, rtol=0, atol=1e-15)
 
 
 def test_both_parts_wear_their_coefficient_times_load_times_sliding(two_turns, measured):

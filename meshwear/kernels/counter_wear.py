@@ -11,6 +11,16 @@ vertex moves by its depth along its inward normal; the faces around a moved
 vertex get their frames again. So the counter's worn volume is its
 coefficient times the pairs' load times slip (or energy), exactly.
 
+A vertex moves once the depth it took since it last moved (its lag) reaches
+:data:`LAG_FRACTION` of the smallest penetration of the pairs that wore it
+since: a step wears a fine counter a thousandth of a contact's penetration
+or less, and fitting its faces anew after every step cost more than the
+face lookups (docs/model.md, "Worn counter-surfaces"). So a contact's
+penetration is off by at most that fraction of itself; the depth, volume and
+work are exact at every step, and :func:`settle_counter` moves every lagging
+vertex (the runs call it before each output and at the end of every stretch
+of steps, so outputs and jumps see the counter where its depth puts it).
+
 Arrays (float64 unless said otherwise) besides those of
 :mod:`meshwear.kernels.contact`:
 
@@ -26,9 +36,11 @@ part : tuple
     (V, 3), tributary areas (V,), local spacing (V,: the shortest edge at the
     vertex), the faces at each vertex (``starts`` (V + 1,) and ``items``
     int64), then what wear changes: vertices (V, 3), face frames (F, 4, 4),
-    wear depth, worn volume, friction work (V,), and scratch: the depth each
-    vertex took in the step (V,, zeros between steps) and the vertices that
-    took some (V,) int64.
+    wear depth, worn volume, friction work (V,), each vertex's lag (V,:
+    the depth it took since it last moved; zeros when settled), the
+    lagging vertices (V,) int64, the lag at which each moves (V,; inf
+    when not lagging), scratch (V,) int64 and the number of lagging
+    vertices (1,) int64.
 """
 
 import numpy as np
@@ -39,17 +51,24 @@ from .laws import wear_increment
 from .nearest import closest_on_triangle
 
 PART_FIELDS = ("law", "faces", "reference", "normals", "tributary", "spacing", "starts", "items",
-               "vertices", "frames", "depth", "volume", "work", "added", "touched")
+               "vertices", "frames", "depth", "volume", "work", "added", "touched", "limit",
+               "due", "count")
 
 #: the part tuple of a surface that does not wear
 NO_PART = (np.array([-1.0, 0.0]), np.zeros((0, 3), np.int64), np.zeros((0, 3)), np.zeros((0, 3)),
            np.zeros(0), np.zeros(0), np.zeros(1, np.int64), np.zeros(0, np.int64),
            np.zeros((0, 3)), np.zeros((0, 4, 4)), np.zeros(0), np.zeros(0), np.zeros(0),
-           np.zeros(0), np.zeros(0, np.int64))
+           np.zeros(0), np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.int64),
+           np.zeros(1, np.int64))
 
 #: a counter vertex may sink by at most this fraction of its shortest edge in
 #: one step; deeper, its faces could fold over
 SPACING_FRACTION = 0.5
+
+#: a counter vertex moves once its lag reaches this fraction of the smallest
+#: penetration of the pairs that wore it since it last moved (or of its
+#: shortest edge, if smaller)
+LAG_FRACTION = 1e-2
 
 #: moved counter vertices from which their faces are fitted anew on threads
 #: (a fine worn flat under a pad: 5 000 vertices, 12 000 faces a step)
@@ -91,12 +110,13 @@ def _face_frame(vertices, faces, f, frames):
 def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_force, planes,
                  hint, rotation, frame, part):
     """Wear the counter-part ``part`` by every pair of the step just taken
-    (``contact_state``, ``normal_force``: this surface's rows). Returns -1,
-    or the first counter vertex that sank deeper than
-    :data:`SPACING_FRACTION` of its spacing in this step (the step is done
-    all the same: the caller stops the run)."""
+    (``contact_state``, ``normal_force``: this surface's rows), and move the
+    vertices whose lag reached their limit. Returns -1, or the first counter
+    vertex that sank deeper than :data:`SPACING_FRACTION` of its spacing
+    since it last moved (the step is done all the same: the caller stops the
+    run)."""
     (counter_law, faces, reference, normals, tributary, spacing, starts, items, vertices, frames,
-     depth, volume, work, added, touched) = part
+     depth, volume, work, added, touched, limit, due, lagging) = part
     code, k_counter = int(counter_law[0]), counter_law[1]
     f, dt = law[0], law[4]
     dt0, dt1 = law[11], law[12]
@@ -104,7 +124,7 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
     cx, cy, cz = pose[0], pose[1], pose[2]
     vx, vy, vz = pose[7], pose[8], pose[9]
     wx, wy, wz = pose[10], pose[11], pose[12]
-    count = 0
+    count = lagging[0]
     for slot in range(active.shape[0]):
         i = active[slot]
         state = contact_state[i]
@@ -171,27 +191,63 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
                     touched[count] = j
                     count += 1
                 added[j] += sink
+                # (-delta: the pair's penetration; none, and it moves now)
+                lag = LAG_FRACTION * min(-delta, spacing[j])
+                if lag < limit[j]:
+                    limit[j] = lag
+    lagging[0] = count
     worst = -1
     for c in range(count):
         j = touched[c]
-        if worst < 0 and added[j] > SPACING_FRACTION * spacing[j]:
+        if added[j] > SPACING_FRACTION * spacing[j]:
             worst = j
-    if count >= PARALLEL_REFIT:
-        _refit_parallel(touched, count, added, reference, depth, normals, vertices, faces,
-                        frames, starts, items)
-    else:
-        _refit_serial(touched, count, added, reference, depth, normals, vertices, faces, frames,
-                      starts, items)
-    for c in range(count):
-        added[touched[c]] = 0.0
+            break
+    _move(part, False)
     return worst
 
 
-def _refit(touched, count, added, reference, depth, normals, vertices, faces, frames, starts,
+@njit(cache=True)
+def settle_counter(part):
+    """Move every lagging vertex of counter-part ``part`` to its depth (its
+    faces fitted anew): the counter where its depth puts it."""
+    _move(part, True)
+
+
+@njit(cache=True)
+def _move(part, every):
+    """Move the lagging vertices whose lag reached their limit (``every``:
+    all of them) to their depth and fit their faces anew; the others keep
+    lagging."""
+    (_, faces, reference, normals, _, _, starts, items, vertices, frames, depth, _, _, added,
+     touched, limit, due, lagging) = part
+    count, kept, moving = lagging[0], 0, 0
+    for c in range(count):
+        j = touched[c]
+        if every or added[j] >= limit[j]:
+            due[moving] = j
+            moving += 1
+            limit[j] = -1.0           # (marks the vertices moving now for _refit)
+        else:
+            touched[kept] = j
+            kept += 1
+    lagging[0] = kept
+    if moving >= PARALLEL_REFIT:
+        _refit_parallel(due, moving, limit, reference, depth, normals, vertices, faces,
+                        frames, starts, items)
+    elif moving > 0:
+        _refit_serial(due, moving, limit, reference, depth, normals, vertices, faces, frames,
+                      starts, items)
+    for c in range(moving):
+        j = due[c]
+        added[j] = 0.0
+        limit[j] = np.inf
+
+
+def _refit(touched, count, marks, reference, depth, normals, vertices, faces, frames, starts,
            items):
     """Move the ``count`` vertices of ``touched`` to their depth along their
     normal, then fit the faces round them anew, each once: by its first
-    moved corner (``added`` not 0; a face under a patch has all three
+    moved corner (``marks`` below 0; a face under a patch has all three
     moved), so no two threads write one face."""
     for c in prange(count):
         j = touched[c]
@@ -204,7 +260,7 @@ def _refit(touched, count, added, reference, depth, normals, vertices, faces, fr
             first = j
             for corner in range(3):
                 k = faces[face, corner]
-                if added[k] != 0.0 and k < first:
+                if marks[k] < 0.0 and k < first:
                     first = k
             if first == j:
                 _face_frame(vertices, faces, face, frames)
