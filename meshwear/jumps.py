@@ -313,7 +313,17 @@ def counter_relief(model, s, m, increments, t):
     m.gamma = np.where(m.mean > 0.0, counter / np.where(m.mean > 0.0, m.mean, 1.0), 0.0)
 
 
-def counter_factors(model, state, measures, results, rates, jump, increments, t):
+def relaxed_share(x):
+    """The share (k,) of a rate's departure kept, on average, over a jump
+    in which it relaxes at ``x`` (k,) (the jump times its relaxation per
+    cycle): ``(1 - e^-x) / x``, 1 at ``x = 0``."""
+    x = np.asarray(x, float)
+    small = x < 1e-12
+    return np.where(small, 1.0, -np.expm1(-x) / np.where(small, 1.0, x))
+
+
+def counter_factors(model, state, measures, results, rates, jump, increments, t, stiffness=None,
+                    previous=None):
     """Per worn counter-part ``j`` (``increments[j]``: its (V,) wear in the
     resolved cycle, or None), the factor (V,) by which the implicit jump
     relieves its wear over ``jump`` cycles, and the relative error (V,) of
@@ -324,7 +334,18 @@ def counter_factors(model, state, measures, results, rates, jump, increments, t)
     (the end of the cycle). The same contact wears both, so the pressure the
     jump relieves relieves the counter's wear as the body's; a counter vertex
     the bodies wore but are not over at ``t`` takes the factor of the nearest
-    one they are over, and one they did not wear keeps its rate (factor 1)."""
+    one they are over, and one they did not wear keeps its rate (factor 1).
+
+    A counter vertex also relaxes on its own, faster than the contact where
+    its stiffness ``g`` (``stiffness[j]``, per cycle: how much its wear falls
+    per unit of its own depth, summed in the wear kernel) is high: a flat's
+    vertex just past a pad's rim, worn by the rim alone. There the jump's
+    error from one measurement overshoots and the next undershoots (its
+    rates alternate), so the part of its rate off the mean of this
+    measurement and the one before (``previous[j]``) relaxes over the jump
+    over the jump as a departure relaxing at ``g`` does
+    (:func:`relaxed_share`), the mean taking the contact's relief
+    (docs/model.md, "Long durations")."""
     out = []
     for j, (surface, increment) in enumerate(zip(model.surfaces.per_vertex, increments)):
         if increment is None:
@@ -371,5 +392,13 @@ def counter_factors(model, state, measures, results, rates, jump, increments, t)
             _, nearest = cKDTree(where[covered]).query(where[swept])
             factor[swept] = factor[covered][nearest]
             relative[swept] = relative[covered][nearest]
+        own = None if stiffness is None else stiffness[j]
+        before = None if previous is None else previous[j]
+        if own is not None and before is not None and len(before) == len(increment):
+            stiff = (increment > 0.0) & (own > 0.0)
+            share = relaxed_share(jump * own[stiff])
+            rate = increment[stiff]
+            mean = 0.5 * (rate + before[stiff])
+            factor[stiff] *= share + (1.0 - share) * mean / rate
         out.append((factor, relative))
     return out

@@ -231,6 +231,10 @@ class PartState:
         lagging vertices (``count`` of them), the lag at which each moves and
         scratch (:func:`meshwear.kernels.counter_wear.wear_counter`); none lag
         between two stretches of steps (:func:`settle_counters`).
+    stiffness : (V,) or (0,) float
+        How much each vertex's wear falls per unit of its own depth, summed
+        over the steps since it was zeroed (kept by cycle jumps; (0,): not
+        kept).
     """
 
     vertices: np.ndarray
@@ -243,6 +247,7 @@ class PartState:
     limit: np.ndarray
     due: np.ndarray
     count: np.ndarray
+    stiffness: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @classmethod
     def unworn(cls, surface):

@@ -234,6 +234,12 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                   if implicit and start > 0 else [None] * len(model.bodies))
         for s in state.bodies:
             s.load[:] = 0.0
+        for j, part in parts:
+            # each counter vertex's own stiffness, summed over the measurement
+            if implicit and len(part.stiffness) != len(part.depth):
+                part.stiffness = np.zeros(len(part.depth))
+                model.surfaces.per_vertex[j].attach(part)      # (its kernel tuple anew)
+            part.stiffness[:] = 0.0
         # a measurement averages the wear of ``window`` consecutive cycles
         # (one, unless single cycles disagree): the last one is recorded for
         # the outputs a jump after it fills
@@ -316,8 +322,14 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
             factors = None
             if parts and implicit:
                 # (before the jump moves the bodies: the feet at the cycle's end)
+                stiffness = [None] * len(state.parts)
+                for j, part in parts:
+                    stiffness[j] = part.stiffness / window
+                previous = [None] * len(state.parts)
+                for (j, _), before_rate in zip(parts, js.part_rate):
+                    previous[j] = before_rate
                 factors = jumps.counter_factors(model, state, measures, results, rates, jump,
-                                                increments, state.time)
+                                                increments, state.time, stiffness, previous)
             spans = _jump(model, state, before, rates, jump, results, measures, window)
             share = None
             if factors is not None:

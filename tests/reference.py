@@ -466,7 +466,7 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
     half their spacing since they last moved (the kernel returns the first
     of them)."""
     (counter_law, faces, reference, normals, tributary, spacing, _, _, vertices, frames, depth,
-     volume, work, added, _, limit, _, _) = part
+     volume, work, added, _, limit, _, _, stiffness) = part
     code, k = int(counter_law[0]), counter_law[1]
     f, dt, dt0, dt1 = law[0], law[4], law[11], law[12]
     R = quaternion_matrix(pose[3:7])
@@ -500,6 +500,11 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
         wore = (weights[:, c] > 0.0) & (dv > 0.0)
         np.minimum.at(limit, corners[wore, c],
                       LAG_FRACTION * np.minimum(-delta[wore], spacing[corners[wore, c]]))
+        # how much its wear falls per unit of its own depth: w^2 dV / (delta A)
+        pressed = wore & (delta < 0.0)
+        if len(stiffness):
+            np.add.at(stiffness, corners[pressed, c], weights[pressed, c] ** 2 * dv[pressed]
+                      / (-delta[pressed] * tributary[corners[pressed, c]]))
     added += depth - before
     deep = np.flatnonzero(added > 0.5 * spacing)
     moved = (added > 0.0) & (added >= limit)
@@ -513,7 +518,7 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
 def settle_counter(part):
     """Twin of :func:`meshwear.kernels.counter_wear.settle_counter`."""
     (_, faces, reference, normals, _, _, _, _, vertices, frames, depth, _, _, added, _, limit,
-     _, _) = part
+     _, _, _) = part
     moved = added > 0.0
     vertices[moved] = reference[moved] - depth[moved, None] * normals[moved]
     added[moved] = 0.0

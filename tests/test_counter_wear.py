@@ -12,7 +12,7 @@ import pyvista
 
 import cases
 import reference
-from meshwear import checkpoint
+from meshwear import checkpoint, jumps
 from meshwear.cli import main
 from meshwear.kernels.counter_wear import settle_counter, wear_counter
 from meshwear.model import build_model, initial_state
@@ -79,6 +79,7 @@ def test_kernel_matches_its_numpy_twin(tmp_path):
         model.bodies[0]
     assert (s.normal_force[0, s.active] > 0.0).sum() > 100, "the case must have pairs"
     rotation, frame = disc.frame(state.time)
+    part.stiffness = np.zeros(len(part.depth))      # (as cycle jumps keep it)
     twin = copy.deepcopy(part)
     args = (s.vertices, s.pose, s.active, body.area_vectors, model.law, s.contact_state[0],
             s.normal_force[0], s.vertex_planes[0], s.hint[0], rotation, frame)
@@ -86,10 +87,10 @@ def test_kernel_matches_its_numpy_twin(tmp_path):
     twin_tuple = (disc.law, disc.faces, disc.reference_vertices, disc.vertex_normals,
                   disc.tributary, disc.spacing, None, None, twin.vertices, twin.frames,
                   twin.depth, twin.volume, twin.work, twin.added, twin.touched, twin.limit,
-                  twin.due, twin.count)
+                  twin.due, twin.count, twin.stiffness)
 
     def same():
-        for name in ("depth", "volume", "work", "vertices", "added", "limit"):
+        for name in ("depth", "volume", "work", "vertices", "added", "limit", "stiffness"):
             np.testing.assert_allclose(getattr(part, name), getattr(twin, name), rtol=1e-12,
                                        atol=1e-12 * np.abs(getattr(twin, name)).max(
                                            where=np.isfinite(getattr(twin, name)),
@@ -120,6 +121,7 @@ def test_kernel_matches_its_numpy_twin(tmp_path):
             break
     assert (part.depth > depth0).sum() > 10
     assert lagged and moved, "the case must have vertices that lag and that move"
+    assert (part.stiffness > 0.0).sum() == (part.depth > depth0).sum()
     settle_counter(disc.part_tuple())
     reference.settle_counter(twin_tuple)
     same()
@@ -344,6 +346,56 @@ def test_the_contact_s_relaxation_is_the_median_over_the_vertices_in_contact(mon
     for m in seen:
         assert m["pressed"] < 0.5 * m["may"]
         assert m["relax"] == pytest.approx(m["both"], rel=1e-12)
+
+
+def test_a_stiff_counter_vertex_jumps_by_the_mean_of_its_rates(monkeypatch):
+    """A cylinder fretting on a worn flat, jumped: each measurement hands
+    the jump each flat vertex's own stiffness (its wear's fall per unit of
+    its own depth, summed in the wear kernel, positive wherever the
+    cylinder wore it while pressing) and the rates measured before; where
+    ``J g`` is large the vertex is jumped by the mean of its last two rates,
+    where small by its own (docs/model.md, "Long durations")."""
+    seen = []
+    factors = jumps.counter_factors
+
+    def spy(model, state, measures, results, rates, jump, increments, t, stiffness=None,
+            previous=None):
+        out = factors(model, state, measures, results, rates, jump, increments, t,
+                      stiffness, previous)
+        plain = factors(model, state, measures, results, rates, jump, increments, t)
+        seen.append((jump, increments[0].copy(), stiffness[0].copy(),
+                     None if previous[0] is None else previous[0].copy(), out[0][0],
+                     plain[0][0]))
+        return out
+
+    monkeypatch.setattr(jumps, "counter_factors", spy)
+    import meshwear
+    from cases import EXAMPLES
+
+    # (3 000 cycles: the jumps grow to J g of about a half)
+    model = build_model(meshwear.load(EXAMPLES / "cylinder_on_worn_flat.toml",
+                                      {"run.duration": 3000.0, "run.frames": 0,
+                                       "wear.acceleration": "cycle_jump"}))
+    run(model, initial_state(model))
+    assert len(seen) >= 2
+    compared, relaxed = 0, []
+    for jump, rate, stiffness, previous, factor, plain in seen:
+        worn = rate > 0.0
+        assert (stiffness[worn] > 0.0).mean() > 0.9 and not stiffness[~worn].any()
+        if previous is None:
+            continue
+        share = -np.expm1(-jump * stiffness) / np.maximum(jump * stiffness, 1e-300)
+        mean = 0.5 * (rate + previous)
+        kept = np.where(worn & (stiffness > 0.0),
+                        share + (1.0 - share) * mean / np.where(worn, rate, 1.0), 1.0)
+        np.testing.assert_allclose(factor, plain * kept, rtol=1e-12)
+        compared += 1
+        stiff = worn & (share < 0.85)
+        if stiff.any():
+            relaxed.append(float(np.abs(kept[stiff] - 1.0).max()))
+    assert compared >= 1
+    # the case has vertices that relax faster than a jump, and rates that moved
+    assert relaxed and max(relaxed) > 1e-3
 
 
 def test_every_history_row_of_a_jumped_run_has_both_parts_forces_balance(tmp_path):

@@ -39,8 +39,13 @@ part : tuple
     wear depth, worn volume, friction work (V,), each vertex's lag (V,:
     the depth it took since it last moved; zeros when settled), the
     lagging vertices (V,) int64, the lag at which each moves (V,; inf
-    when not lagging), scratch (V,) int64 and the number of lagging
-    vertices (1,) int64.
+    when not lagging), scratch (V,) int64, the number of lagging
+    vertices (1,) int64 and each vertex's stiffness (V,, or (0,): not
+    kept): the sum over the pairs that wore it of ``w^2 dV / (delta A)``
+    (``w`` its weight, ``dV`` the pair's volume, ``delta`` its
+    penetration, ``A`` the vertex's tributary area), by how much its wear in
+    the step falls per unit of its own depth (docs/model.md, "Long
+    durations").
 """
 
 import numpy as np
@@ -52,14 +57,14 @@ from .nearest import closest_on_triangle
 
 PART_FIELDS = ("law", "faces", "reference", "normals", "tributary", "spacing", "starts", "items",
                "vertices", "frames", "depth", "volume", "work", "added", "touched", "limit",
-               "due", "count")
+               "due", "count", "stiffness")
 
 #: the part tuple of a surface that does not wear
 NO_PART = (np.array([-1.0, 0.0]), np.zeros((0, 3), np.int64), np.zeros((0, 3)), np.zeros((0, 3)),
            np.zeros(0), np.zeros(0), np.zeros(1, np.int64), np.zeros(0, np.int64),
            np.zeros((0, 3)), np.zeros((0, 4, 4)), np.zeros(0), np.zeros(0), np.zeros(0),
            np.zeros(0), np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.int64),
-           np.zeros(1, np.int64))
+           np.zeros(1, np.int64), np.zeros(0))
 
 #: a counter vertex may sink by at most this fraction of its shortest edge in
 #: one step; deeper, its faces could fold over
@@ -116,7 +121,8 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
     since it last moved (the step is done all the same: the caller stops the
     run)."""
     (counter_law, faces, reference, normals, tributary, spacing, starts, items, vertices, frames,
-     depth, volume, work, added, touched, limit, due, lagging) = part
+     depth, volume, work, added, touched, limit, due, lagging, stiffness) = part
+    keep_stiffness = stiffness.shape[0] > 0
     code, k_counter = int(counter_law[0]), counter_law[1]
     f, dt = law[0], law[4]
     dt0, dt1 = law[11], law[12]
@@ -195,6 +201,8 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
                 lag = LAG_FRACTION * min(-delta, spacing[j])
                 if lag < limit[j]:
                     limit[j] = lag
+                if keep_stiffness and delta < 0.0:
+                    stiffness[j] -= share * sink / delta
     lagging[0] = count
     worst = -1
     for c in range(count):
@@ -219,7 +227,7 @@ def _move(part, every):
     all of them) to their depth and fit their faces anew; the others keep
     lagging."""
     (_, faces, reference, normals, _, _, starts, items, vertices, frames, depth, _, _, added,
-     touched, limit, due, lagging) = part
+     touched, limit, due, lagging, _) = part
     count, kept, moving = lagging[0], 0, 0
     for c in range(count):
         j = touched[c]
