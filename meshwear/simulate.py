@@ -14,6 +14,7 @@ in load balance first). Runs take their steps in the compiled loop
 from functools import partial
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from . import elastic, stepper, surfaces
 from .geometry import inverted_faces
@@ -187,12 +188,16 @@ def run(model, state, observers=(), progress=None, checkpoint=None, compiled=Tru
         When a sample finds NaN, an unbounded state or inverted triangles; the
         observers have seen every sample before it.
     """
-    if model.cycle_steps:
-        # the jumps resolve their cycles with this module's loop
-        resolve = partial(advance, compiled=compiled)
-        return run_cycle_jump(model, state, resolve, check, observers, progress, checkpoint,
-                              forced_jump)
-    advance(model, state, model.n_steps, observers, progress, checkpoint, compiled)
+    # numpy's BLAS on one thread while the run lasts: its threads spin on
+    # after each call, and on a small machine they took the cores from the
+    # compiled loop's (docs/performance.md, "Threads")
+    with threadpool_limits(limits=1, user_api="blas"):
+        if model.cycle_steps:
+            # the jumps resolve their cycles with this module's loop
+            resolve = partial(advance, compiled=compiled)
+            return run_cycle_jump(model, state, resolve, check, observers, progress, checkpoint,
+                                  forced_jump)
+        advance(model, state, model.n_steps, observers, progress, checkpoint, compiled)
     return state
 
 
