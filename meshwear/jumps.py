@@ -343,7 +343,7 @@ def counter_factors(model, state, measures, results, rates, jump, increments, t,
     error from one measurement overshoots and the next undershoots (its
     rates alternate), so the part of its rate off the mean of this
     measurement and the one before (``previous[j]``) relaxes over the jump
-    over the jump as a departure relaxing at ``g`` does
+    as a departure relaxing at ``g`` does
     (:func:`relaxed_share`), the mean taking the contact's relief
     (docs/model.md, "Long durations")."""
     out = []
