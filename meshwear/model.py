@@ -226,15 +226,15 @@ class PartState:
         Their faces' frames (:func:`meshwear.kernels.nearest.face_frames`).
     depth, volume, work : (V,) float
         Wear depth (m), worn volume (m³) and friction work (J) per vertex.
-    added : (V,) float, touched : (V,) int64, limit : (V,) float, due : (V,) int64, count : (1,) int64
+    added, touched, limit, due, count : (V,) float, (V,) int64, (V,) float, (V,) int64, (1,) int64
         Each vertex's lag (the depth it took since it last moved), the
         lagging vertices (``count`` of them), the lag at which each moves and
         scratch (:func:`meshwear.kernels.counter_wear.wear_counter`); none lag
         between two stretches of steps (:func:`settle_counters`).
     stiffness : (V,) or (0,) float
         How much each vertex's wear falls per unit of its own depth, summed
-        over the steps since it was zeroed (kept by cycle jumps; (0,): not
-        kept).
+        over the steps since it was zeroed (kept for implicit cycle jumps;
+        (0,): not kept).
     """
 
     vertices: np.ndarray
@@ -250,13 +250,15 @@ class PartState:
     stiffness: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @classmethod
-    def unworn(cls, surface):
+    def unworn(cls, surface, stiffness=False):
+        """The unworn state of ``surface``; ``stiffness``: keep each vertex's."""
         n = len(surface.reference_vertices)
         return cls(vertices=surface.reference_vertices.copy(),
                    frames=face_frames(surface.reference_vertices, surface.faces),
                    depth=np.zeros(n), volume=np.zeros(n), work=np.zeros(n), added=np.zeros(n),
                    touched=np.zeros(n, np.int64), limit=np.full(n, np.inf),
-                   due=np.zeros(n, np.int64), count=np.zeros(1, np.int64))
+                   due=np.zeros(n, np.int64), count=np.zeros(1, np.int64),
+                   stiffness=np.zeros(n if stiffness else 0))
 
 
 @dataclass(eq=False)
@@ -726,7 +728,10 @@ def initial_state(model):
             active=all_vertices(n), active_wear=np.zeros(n), cull=np.zeros(surfaces.CULL_SIZE),
             cull_scratch=surfaces.Cull(np.zeros(n), np.zeros((n, 3, 3)) if M else None,
                                        np.full(n, -1, dtype=np.int64))))
-    parts = [PartState.unworn(m) if m.worn else None for m in model.surfaces.per_vertex]
+    # (implicit cycle jumps relieve each counter vertex by its own stiffness)
+    stiffness = bool(model.cycle_steps) and model.scene.wear.jump == "implicit"
+    parts = [PartState.unworn(m, stiffness) if m.worn else None
+             for m in model.surfaces.per_vertex]
     for m, part in zip(model.surfaces.per_vertex, parts):
         if part is not None:
             m.attach(part)

@@ -236,12 +236,8 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                   if implicit and start > 0 else [None] * len(model.bodies))
         for s in state.bodies:
             s.load[:] = 0.0
-        for j, part in parts:
-            # each counter vertex's own stiffness, summed over the measurement
-            if implicit and len(part.stiffness) != len(part.depth):
-                part.stiffness = np.zeros(len(part.depth))
-                model.surfaces.per_vertex[j].attach(part)      # (its kernel tuple anew)
-            part.stiffness[:] = 0.0
+        for _, part in parts:
+            part.stiffness[:] = 0.0      # each counter vertex's, summed over the measurement
         # a measurement averages the wear of ``window`` consecutive cycles
         # (one, unless single cycles disagree): the last one is recorded for
         # the outputs a jump after it fills
@@ -324,11 +320,10 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
             factors = None
             if parts and implicit:
                 # (before the jump moves the bodies: the feet at the cycle's end)
-                stiffness = [None] * len(state.parts)
-                for j, part in parts:
-                    stiffness[j] = part.stiffness / window
-                previous = [None] * len(state.parts)
-                for (j, _), before_rate in zip(parts, js.part_rate):
+                stiffness, previous = [None] * len(state.parts), [None] * len(state.parts)
+                for (j, part), before_rate in zip(parts, js.part_rate):
+                    if len(part.stiffness):
+                        stiffness[j] = part.stiffness / window
                     previous[j] = before_rate
                 factors = jumps.counter_factors(model, state, measures, results, rates, jump,
                                                 increments, state.time, stiffness, previous)
@@ -957,8 +952,8 @@ def _relaxation(measures):
     inverse of the median, over the vertices in contact, of their own and
     their counter-part's wear per cycle per unit penetration); inf when
     nothing wears."""
-    rates = [(m.alpha if m.gamma is None else m.alpha + m.gamma)[
-        m.member & (m.alpha > 0.0) & (m.mean > 0.0)] for m in measures or ()]
+    rates = [_relax_rate(m)[m.member & (m.alpha > 0.0) & (m.mean > 0.0)]
+             for m in measures or ()]
     rates = np.concatenate(rates) if rates else np.zeros(0)
     middle = float(np.median(rates)) if len(rates) else 0.0
     return 1.0 / middle if middle > 0.0 else np.inf
