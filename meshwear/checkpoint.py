@@ -123,6 +123,10 @@ def save(path, model, state, wall_time):
                                           dtype=float).reshape(-1, 1 + len(state.bodies))
         arrays["jump_window"] = np.array([js.window, js.relax])
         arrays["jump_history_times"] = np.array([t for t, _, _ in js.history])
+        for k, past in enumerate(js.part_past):
+            arrays[f"jump_part{k}_past_times"] = np.array([t for t, *_ in past])
+            for h, (_, depth, rate, stiffness) in enumerate(past):
+                arrays[f"jump_part{k}_past{h}"] = np.stack([depth, rate, stiffness])
         for h, (_, alphas, part_rates) in enumerate(js.history):
             for k, alpha in enumerate(alphas or ()):
                 arrays[f"jump_history{h}_alpha{k}"] = alpha
@@ -238,6 +242,10 @@ def load(path, model, state):
                                 for s, v in zip(state.bodies, variance[:n])]
                 js.part_noise_var = [np.full(len(p.depth), v)
                                      for p, v in zip(worn, variance[n:])]
+            js.part_past = [[(float(t), *data[f"jump_part{k}_past{h}"].copy())
+                             for h, t in enumerate(data[f"jump_part{k}_past_times"])]
+                            if f"jump_part{k}_past_times" in data else []
+                            for k in range(len(worn))]
             for h, t in enumerate(data["jump_history_times"]):
                 alphas = [data[f"jump_history{h}_alpha{k}"].copy() for k in range(n)
                           if f"jump_history{h}_alpha{k}" in data]

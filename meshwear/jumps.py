@@ -322,8 +322,40 @@ def relaxed_share(x):
     return np.where(small, 1.0, -np.expm1(-x) / np.where(small, 1.0, x))
 
 
+def settled_rates(rate, stiffness, depth, t, past):
+    """(V,) the wear per cycle each counter vertex settles to, the contact's:
+    its rate ``rate`` (m per cycle) less the departure the error of its own
+    depth makes.
+
+    A vertex of stiffness ``g`` (per cycle, ``stiffness``) that sank by
+    ``e`` more than the contact wears ``g e`` less, so between an earlier
+    measurement and this one, ``T`` cycles apart, over which its depth at
+    the measurements' middles went from ``d0`` to ``depth`` (m) and its rate
+    from ``r0`` to ``rate``, ``rate - r0 = -g (depth - d0 - r_c T)`` for a
+    settled rate ``r_c`` holding over them:
+    ``r_c = (depth - d0 + (rate - r0) / g) / T``, ``g`` the mean of both
+    measurements' stiffnesses. ``past``: the earlier measurements, oldest
+    first, each ``(time, d0, r0, g0)`` (``t`` and ``time`` their middles,
+    cycles); each vertex takes the latest one at least ``1 / g`` cycles
+    before (nearer, the rates' scatter over ``g T`` swamps the difference)
+    and touched in each one since (``g0 > 0``: where it was not, it was
+    deeper than the contact and its rate not linear in its depth). A vertex
+    with none keeps its rate. Never below zero."""
+    settled = rate.copy()
+    todo = stiffness > 0.0
+    for time, d0, r0, g0 in reversed(past):
+        if not todo.any():
+            break
+        cycles = t - time
+        g = 0.5 * (stiffness + g0)
+        use = todo & (g0 > 0.0) & (g * cycles >= 1.0)
+        settled[use] = (depth[use] - d0[use] + (rate[use] - r0[use]) / g[use]) / cycles
+        todo &= ~use & (g0 > 0.0)
+    return np.maximum(settled, 0.0)
+
+
 def counter_factors(model, state, measures, results, rates, jump, increments, t, stiffness=None,
-                    previous=None):
+                    settled=None):
     """Per worn counter-part ``j`` (``increments[j]``: its (V,) wear in the
     resolved cycle, or None), the factor (V,) by which the implicit jump
     relieves its wear over ``jump`` cycles, and the relative error (V,) of
@@ -339,12 +371,12 @@ def counter_factors(model, state, measures, results, rates, jump, increments, t,
     A counter vertex also relaxes on its own, faster than the contact where
     its stiffness ``g`` (``stiffness[j]``, per cycle: how much its wear falls
     per unit of its own depth, summed in the wear kernel) is high: a flat's
-    vertex just past a pad's rim, worn by the rim alone. There the jump's
-    error from one measurement overshoots and the next undershoots (its
-    rates alternate), so the part of its rate off the mean of this
-    measurement and the one before (``previous[j]``) relaxes over the jump
-    as a departure relaxing at ``g`` does
-    (:func:`relaxed_share`), the mean taking the contact's relief
+    vertex just past a pad's rim, worn by the rim alone. Jumped at its
+    measured rate, the error of its depth that rate carries overshoots, and
+    the next jump undershoots (its rates alternate). So the part of its rate
+    off the rate it settles to (``settled[j]``, :func:`settled_rates`)
+    relaxes over the jump as a departure relaxing at ``g`` does
+    (:func:`relaxed_share`), the settled rate taking the contact's relief
     (docs/model.md, "Long durations")."""
     out = []
     for j, (surface, increment) in enumerate(zip(model.surfaces.per_vertex, increments)):
@@ -393,12 +425,15 @@ def counter_factors(model, state, measures, results, rates, jump, increments, t,
             factor[swept] = factor[covered][nearest]
             relative[swept] = relative[covered][nearest]
         own = None if stiffness is None else stiffness[j]
-        before = None if previous is None else previous[j]
-        if own is not None and before is not None and len(before) == len(increment):
+        target = None if settled is None else settled[j]
+        if own is not None and target is not None and len(target) == len(increment):
             stiff = (increment > 0.0) & (own > 0.0)
             share = relaxed_share(jump * own[stiff])
             rate = increment[stiff]
-            mean = 0.5 * (rate + before[stiff])
-            factor[stiff] *= share + (1.0 - share) * mean / rate
+            # the jump wears it J (f r_c + phi (r - r_c)): the contact's
+            # relief f for the rate it settles to, its own relaxation for the
+            # departure
+            settle = target[stiff] / rate
+            factor[stiff] = np.maximum(factor[stiff] * settle + share * (1.0 - settle), 0.0)
         out.append((factor, relative))
     return out

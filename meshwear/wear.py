@@ -134,6 +134,10 @@ class JumpState:
                                                     # per body its worn volume per cycle, m^3)
     noisy: bool = False                             # a jump of twice the window, by its own
                                                     # noise alone, would break the tolerance
+    part_past: list = field(default_factory=list)  # per worn counter-part: its last
+                                                    # measurements (at most HISTORY), each
+                                                    # (middle, cycles; (V,) depth then, m;
+                                                    # rate, m per cycle; stiffness, per cycle)
 
 
 def penetration(model, body, s):
@@ -213,6 +217,8 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
     js = state.jump
     if len(js.part_noise) != len(parts):
         js.part_noise = [None] * len(parts)
+    if len(js.part_past) != len(parts):
+        js.part_past = [[] for _ in parts]
     if len(js.part_noise_var) != len(parts):
         js.part_noise_var = [np.zeros(len(p.depth)) for _, p in parts]
     if len(js.noise_var) != len(model.bodies):
@@ -265,16 +271,30 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                      for body, s, rate, start in zip(model.bodies, state.bodies, rates, starts)]
                     if implicit else None)
         middle = state.step / n_c - 0.5 * window
-        for k, rate in enumerate(part_rates):
-            js.part_noise[k] = _counter_noise(js, k, rate, middle)
+        # (the counter's wear under a body vertex at the rate it settles
+        # to: a counter vertex catching up with the contact wears faster for
+        # a few cycles, and read as the contact's it relieved the bodies'
+        # jumps, and its own, by as much as it took; and its scatter is the
+        # noise the jumps extrapolate, the departure relaxing on its own)
+        increments = [None] * len(state.parts)
+        settled = [None] * len(state.parts)
+        settled_rates = []
+        for k, ((j, part), rate) in enumerate(zip(parts, part_rates)):
+            increments[j] = settled[j] = rate
+            if implicit and len(part.stiffness):
+                stiffness = part.stiffness / window
+                depth = before_parts[k][0] + 0.5 * window * rate
+                settled[j] = jumps.settled_rates(rate, stiffness, depth, middle,
+                                                 js.part_past[k])
+                js.part_past[k] = (js.part_past[k] + [(middle, depth, rate, stiffness)]
+                                   )[-HISTORY:]
+            settled_rates.append(settled[j])
+            js.part_noise[k] = _counter_noise(js, k, settled[j], middle)
         if parts:
             # (before the relaxation: the counter-part's wear under each
             # body vertex relaxes its errors too, gamma_i)
-            increments = [None] * len(state.parts)
-            for (j, _), rate in zip(parts, part_rates):
-                increments[j] = rate
             for s, m in zip(state.bodies, measures):
-                jumps.counter_relief(model, s, m, increments, state.time)
+                jumps.counter_relief(model, s, m, settled, state.time)
         js.relax = _relaxation(measures)
         _relax_resolved(js, measures, part_rates, window)
         js.noisy = False
@@ -320,13 +340,12 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
             factors = None
             if parts and implicit:
                 # (before the jump moves the bodies: the feet at the cycle's end)
-                stiffness, previous = [None] * len(state.parts), [None] * len(state.parts)
-                for (j, part), before_rate in zip(parts, js.part_rate):
+                stiffness = [None] * len(state.parts)
+                for j, part in parts:
                     if len(part.stiffness):
                         stiffness[j] = part.stiffness / window
-                    previous[j] = before_rate
                 factors = jumps.counter_factors(model, state, measures, results, rates, jump,
-                                                increments, state.time, stiffness, previous)
+                                                increments, state.time, stiffness, settled)
             spans = _jump(model, state, before, rates, jump, results, measures, window)
             share = None
             if factors is not None:
@@ -360,7 +379,7 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                 alpha[m.index] = np.where(m.mean > 0.0, m.alpha, 0.0)
                 js.alpha.append(alpha)
         js.history = (js.history + [(middle, js.alpha if implicit else None,
-                                      part_rates)])[1 - HISTORY:]
+                                      settled_rates)])[1 - HISTORY:]
         following = window
         if (forced_jump is None and which in NOISY and jump < 2 * window
                 and window < MAX_WINDOW and js.noisy):
