@@ -402,10 +402,12 @@ def counter_factors(model, state, measures, results, rates, jump, increments, t,
             # contact, carried its factor to the counter's whole wear there:
             # the gear pair's wheel wore twice the pinion's volume)
             share = weights * own[:, None]
-            for c in range(3):
-                np.add.at(weight, corners[:, c], share[:, c])
-                np.add.at(relief, corners[:, c], share[:, c] * factor)
-                np.add.at(error, corners[:, c], share[:, c] * relative)
+            # (summed corner by corner, in order, as np.add.at would: bincount
+            # adds in its input's order)
+            at = corners.T.ravel()
+            for total, values in ((weight, share), (relief, share * factor[:, None]),
+                                  (error, share * relative[:, None])):
+                total += np.bincount(at, values.T.ravel(), minlength=len(total))
         covered = weight > 0.0
         factor = np.ones(len(increment))
         factor[covered] = relief[covered] / weight[covered]
