@@ -25,7 +25,8 @@ from .kernels.balance import balance_offset
 from .kernels.rigid import (ACCELERATION, AXIS, BALANCED, CARRIED, CIRCLE, FIXED, FREE, GUIDED,
                             INERTIA, INVERSE_INERTIA, INVERSE_MASS, MOTION_PARAMS, OSCILLATION,
                             ORIENTATION, PRESCRIBED, START, STEADY, TURN_AXIS, TURN_CENTER,
-                            TURN_RATE, advance_motion, path_point, place_motion)
+                            TURN_RATE, advance_free_motion, advance_motion, path_point,
+                            place_motion)
 
 
 class Path:
@@ -151,6 +152,14 @@ class FreeMotion(Motion):
 
     def __init__(self, mass, inertia, acceleration):
         super().__init__(mass=mass, inertia=np.asarray(inertia, float), acceleration=acceleration)
+
+    # (no path: a free body's first run compiles none of the paths' kernels)
+    def place(self, pose, t):
+        """A free body has no path-driven part."""
+
+    def advance(self, pose, wrench, t, dt):
+        advance_free_motion(self.kind, self.params, self.path.terms, self.path.buffer, pose,
+                            wrench, float(t), float(dt))
 
 
 class PrescribedMotion(Motion):

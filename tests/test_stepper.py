@@ -164,3 +164,19 @@ def test_a_load_nothing_carries_stops_the_compiled_loop_as_the_python_step(tmp_p
             run(model, initial_state(model), compiled=compiled)
         messages.append(str(err.value))
     assert messages[0] == messages[1]
+
+
+def test_a_first_run_compiles_the_loop_its_scene_needs(tmp_path):
+    """Free bodies on one plane, dynamic (the demo), step in the build that
+    leaves out the paths and the quasi-static balance; a guided body on one
+    plane, or a quasi-static run, in the one-plane build that has them; a
+    mesh counter-surface in the full build (docs/performance.md, "The first
+    run compiles")."""
+    from meshwear.kernels import loop
+
+    scenes = _scenes(tmp_path)
+    builds = {name: loop.loop_for(build_model(scenes[name])) for name in
+              ("free cube, plane", "guided block, dynamic", "pin, turning disc mesh")}
+    assert builds["free cube, plane"] is loop.advance_body_one_plane_free
+    assert builds["guided block, dynamic"] is loop.advance_body_one_plane
+    assert builds["pin, turning disc mesh"] is loop.advance_body

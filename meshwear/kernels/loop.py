@@ -47,7 +47,8 @@ from .contact import (BUILDS, PARALLEL_THRESHOLD, _named_copy, contact_parallel,
 from .counter import fill_planes
 from .counter_wear import wear_counter
 from .frames import moved_since_refresh, plane_rows, step_motion, surface_frame
-from .rigid import AXIS, BALANCED, CARRIED, advance_motion, place_motion
+from .rigid import (AXIS, BALANCED, CARRIED, FIXED, FREE, advance_free_motion,
+                    advance_motion, place_motion)
 
 #: what :func:`advance_body` returns besides the step it reached
 DONE, REFRESH, FINISH, NO_BALANCE, TOO_DEEP, IMPACT = 0, 1, 2, 3, 4, 5
@@ -62,6 +63,10 @@ DONE, REFRESH, FINISH, NO_BALANCE, TOO_DEEP, IMPACT = 0, 1, 2, 3, 4, 5
 #: the build's constants: mesh counter-surfaces, the threaded contact kernel,
 #: and the serial contact kernel it calls
 MESHES, PARALLEL, SERIAL_CONTACT = True, True, contact_serial
+#: a build for dynamic runs only: the quasi-static step (the path placed at
+#: the step's end, the load balance) is left out (the build for free bodies
+#: also takes ``advance_motion=advance_free_motion``)
+DYNAMIC_ONLY = False
 
 
 def _fill(body, planes, surfaces, t, buffer, rotation, frame):
@@ -220,7 +225,7 @@ def _advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes,
             and scratch.shape[1] < active.shape[0] * (plane_array.shape[0] + vertex_planes.shape[0])):
         return k, REFRESH                # Python grows the scratch
     while k < stop:
-        if not quasi_static:
+        if DYNAMIC_ONLY or not quasi_static:
             t = k * dt
             if _needs_refresh(body, bounds, terms, t, dt, buffer, cull_enabled):
                 return k, REFRESH
@@ -292,11 +297,17 @@ advance_body = _loop_build("")
 #: the threaded kernel's threshold: the serial one-plane contact only
 advance_body_one_plane = _loop_build("_one_plane", MESHES=False, PARALLEL=False,
                                      SERIAL_CONTACT=BUILDS["contact_serial"][1])
+#: and of those, a dynamic run of free bodies (tossed or dropped on a floor)
+advance_body_one_plane_free = _loop_build(
+    "_one_plane_free", MESHES=False, PARALLEL=False, SERIAL_CONTACT=BUILDS["contact_serial"][1],
+    DYNAMIC_ONLY=True, advance_motion=advance_free_motion)
 
 
 def loop_for(model):
     """The build of :func:`advance_body` that ``model`` needs."""
     if (model.planes.shape[0] == 1 and not model.surfaces.per_vertex
             and all(len(b.tributary_area) < PARALLEL_THRESHOLD for b in model.bodies)):
+        if not model.quasi_static and all(b.motion.kind in (FREE, FIXED) for b in model.bodies):
+            return advance_body_one_plane_free
         return advance_body_one_plane
     return advance_body

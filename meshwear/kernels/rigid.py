@@ -7,7 +7,7 @@ quaternion (w, x, y, z), velocity, angular velocity (world frame).
 import numpy as np
 from numba import njit
 
-from .contact import rotation_entries
+from .contact import _named_copy, rotation_entries
 
 
 @njit(cache=True, inline="always")
@@ -239,13 +239,19 @@ def place_motion(kind, params, terms, buffer, pose, t):
         turn(pose, params, axis, t)
 
 
-@njit(cache=True)
-def advance_motion(kind, params, terms, buffer, pose, wrench, t, dt):
+#: a build for free bodies only (:data:`advance_free_motion`): the paths'
+#: code is left out (numba prunes a branch on a constant before typing it)
+FREE_ONLY = False
+
+
+def _advance_motion(kind, params, terms, buffer, pose, wrench, t, dt):
     """Advance ``pose`` from ``t`` to ``t + dt`` under the contact ``wrench``
     (dynamic mode)."""
     if kind == FREE:
         free_step(pose, wrench, params[INVERSE_MASS], params[INERTIA].reshape(3, 3),
                   params[INVERSE_INERTIA].reshape(3, 3), params[ACCELERATION], dt)
+    elif FREE_ONLY:
+        return
     elif kind == GUIDED:
         guided_step(pose, wrench, params[INVERSE_MASS], params[ACCELERATION], params[AXIS],
                     params[START], terms, t, dt, buffer)
@@ -253,3 +259,9 @@ def advance_motion(kind, params, terms, buffer, pose, wrench, t, dt):
     elif kind == PRESCRIBED:
         place_on_path(pose, params[START], terms, np.zeros(3), 0.0, 0.0, t + dt, buffer)
         turn(pose, params, np.zeros(3), t + dt)
+
+
+advance_motion = njit(cache=True)(_named_copy(_advance_motion, "advance_motion"))
+#: the same for free (and fixed) bodies only
+advance_free_motion = njit(cache=True)(_named_copy(_advance_motion, "advance_free_motion",
+                                                   FREE_ONLY=True))
