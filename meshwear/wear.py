@@ -113,7 +113,8 @@ class JumpState:
     window: int = 1                                 # resolved cycles a measurement averages
     history: list = field(default_factory=list)     # the measurements before at this window
                                                     # (at most HISTORY - 1): (their middle,
-                                                    # cycles; per body alpha; per part rate)
+                                                    # cycles; per body alpha; per part the
+                                                    # rates it settles to)
     relax: float = np.inf                           # cycles the contact relaxes errors over
     noise_var: list = field(default_factory=list)  # per body (n,): the variance (m^2) the
                                                     # jumps' noise added to its depth
@@ -278,15 +279,16 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
         # noise the jumps extrapolate, the departure relaxing on its own)
         increments = [None] * len(state.parts)
         settled = [None] * len(state.parts)
+        stiffness = [None] * len(state.parts)     # per cycle, summed in the wear kernel
         settled_rates = []
         for k, ((j, part), rate) in enumerate(zip(parts, part_rates)):
             increments[j] = settled[j] = rate
             if implicit and len(part.stiffness):
-                stiffness = part.stiffness / window
+                stiffness[j] = part.stiffness / window
                 depth = before_parts[k][0] + 0.5 * window * rate
-                settled[j] = jumps.settled_rates(rate, stiffness, depth, middle,
+                settled[j] = jumps.settled_rates(rate, stiffness[j], depth, middle,
                                                  js.part_past[k])
-                js.part_past[k] = (js.part_past[k] + [(middle, depth, rate, stiffness)]
+                js.part_past[k] = (js.part_past[k] + [(middle, depth, rate, stiffness[j])]
                                    )[-HISTORY:]
             settled_rates.append(settled[j])
             js.part_noise[k] = _counter_noise(js, k, settled[j], middle)
@@ -340,10 +342,6 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
             factors = None
             if parts and implicit:
                 # (before the jump moves the bodies: the feet at the cycle's end)
-                stiffness = [None] * len(state.parts)
-                for j, part in parts:
-                    if len(part.stiffness):
-                        stiffness[j] = part.stiffness / window
                 factors = jumps.counter_factors(model, state, measures, results, rates, jump,
                                                 increments, state.time, stiffness, settled)
             spans = _jump(model, state, before, rates, jump, results, measures, window)
@@ -981,7 +979,9 @@ def _relaxation(measures):
 def _counter_noise(js, k, rate, t):
     """The sampling noise of worn counter-part ``k``'s wear per cycle (V,)
     (m): each vertex's scatter (:func:`_local_scatter`) of its rate
-    ``rate`` in this measurement (its middle at ``t``, cycles) and the ones
+    ``rate`` (the one it settles to, :func:`meshwear.jumps.settled_rates`:
+    the departure from it its own depth's error makes is no sampling noise)
+    in this measurement (its middle at ``t``, cycles) and the ones
     before at the same window about their trend (the rates of a contact
     that widens fall cycle after cycle, and those of a vertex it reaches
     rise to their own: that is no noise). None before three measurements."""
