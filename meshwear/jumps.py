@@ -18,7 +18,7 @@ cycle (:func:`measure`), ``beta_i`` the free axis along its normal, ``L``
 the load: each vertex wears ``J alpha_i (phat_i - beta_i z) / (1 + J
 alpha_i)`` (at most its penetration, whatever ``J``), its end penetration
 becomes ``(p_i + J alpha_i (p_i - phat_i) - beta_i z) / (1 + J alpha_i)`` and ``z`` is
-a 1-D monotone solve (:func:`balance`). A vertex touched during the cycle
+a 1-D monotone solve (:func:`meshwear.kernels.balance.implicit_step`). A vertex touched during the cycle
 but not at its end wears alike but does not take part in the balance (its
 normal, if it faces no surface then, is its own). A vertex out of contact
 that the move brings in wears as the contact does on average per unit
@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .elastic import equivalent_depth
-from .kernels.balance import solve
+from .kernels.balance import implicit_step
 from .kernels.contact import FACING
 from .motion import BalancedMotion, GuidedMotion, MechanismMotion
 from .surfaces import quaternion_matrix, vertex_feet
@@ -77,25 +77,6 @@ def contact_geometry(model, body, s, index):
     if model.elastic is not None:
         depth = equivalent_depth(model, body, s, index, depth, area)
     return depth, normal, model.law[5] + model.law[6] * area
-
-
-def balance(depth, beta, stiffness, load):
-    """The move ``z`` (m) at which ``sum_j k_j beta_j (d_j - beta_j z)_+ = load``
-    (N): the quasi-static balance's solve (:func:`meshwear.kernels.balance.solve`)
-    on these pairs. 0 when no pair can carry the load.
-
-    Parameters
-    ----------
-    depth, beta, stiffness : (m,) float
-        Penetration at ``z = 0`` (m), the axis along the normal, stiffness (N/m).
-    load : float
-    """
-    ok = (beta != 0.0) & (stiffness > 0.0) & np.isfinite(depth)
-    b = beta[ok]
-    breaks = np.ascontiguousarray(depth[ok] / b)
-    weights = np.ascontiguousarray(stiffness[ok] * b * np.abs(b))
-    z = solve(breaks, weights, len(breaks), float(load), 0.0, np.nan) if len(breaks) else np.nan
-    return float(z) if np.isfinite(z) else 0.0
 
 
 #: a vertex the surface it faces sees less than this share of is on a sharp
@@ -230,22 +211,15 @@ def _step(m, jump, depth, now):
     """One backward-Euler step of ``jump`` cycles from the penetrations at
     the end of the cycle ``depth`` and while in contact ``now``
     (:attr:`BodyJump.now`): (n,) wear, the move z and (n,) the penetration
-    the step takes off (its own and the counter-parts' wear)."""
-    rate = m.alpha if m.gamma is None else m.alpha + m.gamma
-    relief = 1.0 / (1.0 + jump * rate)
-    z = 0.0
-    k = m.member
-    if m.guided:
-        # a member's end penetration after the step, (ahead - beta z) relief
-        ahead = depth[k] + jump * rate[k] * (depth[k] - now[k])
-        z = balance(ahead, m.beta[k], m.stiffness[k] * relief[k], m.load)
-    # the penetration the step leaves (relieved), for members and touched
-    # ones: the move takes the same off a touched vertex's penetration
-    # (the body sinks as a disc's whole track wears, and presses it again)
-    left = np.zeros(len(depth))
-    k = k | m.touched
-    left[k] = np.maximum(0.0, now[k] - m.beta[k] * z) * relief[k]
-    return jump * m.alpha * left, z, jump * rate * left
+    the step takes off (its own and the counter-parts' wear), by
+    :func:`meshwear.kernels.balance.implicit_step`. The balance solves for
+    a member's end penetration after the step, ``(ahead - beta z) relief``;
+    a touched vertex's is relieved alike (the body sinks as a disc's whole
+    track wears, and presses it again)."""
+    gamma = m.gamma if m.gamma is not None else np.zeros(len(m.alpha))
+    wear, z, taken = implicit_step(float(jump), m.alpha, gamma, m.member, m.touched, m.beta,
+                                   m.stiffness, depth, now, float(m.load), bool(m.guided))
+    return wear, float(z), taken
 
 
 def _steps(m, jump, n):

@@ -557,3 +557,28 @@ def deepest_penetration(body_vertices, pose, planes, vertex_planes, active, cont
         if depth[k] > best[0]:
             best = (float(depth[k]), s, int(active[k]))
     return best
+
+
+def implicit_step(jump, alpha, gamma, member, touched, beta, stiffness, depth, now, load, guided):
+    """numpy twin of meshwear.kernels.balance.implicit_step (the balance by
+    the compiled bracketed Newton ``solve``, which balance_offset's twin
+    checks)."""
+    from meshwear.kernels.balance import solve
+
+    rate = alpha + gamma
+    relief = 1.0 / (1.0 + jump * rate)
+    z = 0.0
+    k = member
+    if guided:
+        ahead = depth[k] + jump * rate[k] * (depth[k] - now[k])
+        b, stiff = beta[k], stiffness[k] * relief[k]
+        ok = (b != 0.0) & (stiff > 0.0) & np.isfinite(ahead)
+        b = b[ok]
+        breaks = np.ascontiguousarray(ahead[ok] / b)
+        weights = np.ascontiguousarray(stiff[ok] * b * np.abs(b))
+        z = solve(breaks, weights, len(breaks), float(load), 0.0, np.nan) if len(breaks) else 0.0
+        z = float(z) if np.isfinite(z) else 0.0
+    left = np.zeros(len(depth))
+    k = k | touched
+    left[k] = np.maximum(0.0, now[k] - beta[k] * z) * relief[k]
+    return jump * alpha * left, z, jump * rate * left

@@ -217,3 +217,50 @@ def solve(breakpoint, weight, count, load, guess, bound):
         trial = z + (g - load) / slope if slope > 0.0 else 0.5 * (lo + hi)
         z = trial if lo < trial < hi else 0.5 * (lo + hi)
     return z
+
+
+@njit(cache=True)
+def implicit_step(jump, alpha, gamma, member, touched, beta, stiffness, depth, now, load, guided):
+    """One backward-Euler step of ``jump`` cycles of a body's jump
+    (:func:`meshwear.jumps.implicit`; docs/model.md, "Long durations"), from
+    the penetrations at the end of the cycle ``depth`` and while in contact
+    ``now`` (k,): its wear (k,), the move ``z`` along the free axis (0
+    unless ``guided``, or when no pair carries the load) and the
+    penetration (k,) the step takes off (its own and the counter-parts'
+    wear). Per vertex ``alpha`` and ``gamma`` (its and the counter's wear
+    per cycle per unit penetration, 1 / cycle), ``beta`` the free axis along
+    its normal, ``stiffness`` (N/m); ``member`` (the balance's pairs) and
+    ``touched`` (touched during the cycle, not at its end) masks; ``load``
+    (N) the balance's."""
+    n = alpha.shape[0]
+    z = 0.0
+    if guided:
+        # a member's end penetration after the step, (ahead - beta z) relief
+        breaks, weights = np.empty(n), np.empty(n)
+        count = 0
+        for i in range(n):
+            if member[i]:
+                rate = alpha[i] + gamma[i]
+                relief = 1.0 / (1.0 + jump * rate)
+                ahead = depth[i] + jump * rate * (depth[i] - now[i])
+                k = stiffness[i] * relief
+                b = beta[i]
+                if b != 0.0 and k > 0.0 and np.isfinite(ahead):
+                    breaks[count] = ahead / b
+                    weights[count] = k * b * abs(b)
+                    count += 1
+        if count:
+            z = solve(breaks, weights, count, load, 0.0, np.nan)
+            if not np.isfinite(z):
+                z = 0.0
+    # the penetration the step leaves (relieved), for members and touched
+    # ones: the move takes the same off a touched vertex's penetration
+    wear, taken = np.zeros(n), np.zeros(n)
+    for i in range(n):
+        if member[i] or touched[i]:
+            rate = alpha[i] + gamma[i]
+            relief = 1.0 / (1.0 + jump * rate)
+            left = max(0.0, now[i] - beta[i] * z) * relief
+            wear[i] = jump * alpha[i] * left
+            taken[i] = jump * rate * left
+    return wear, z, taken
