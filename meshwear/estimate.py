@@ -154,9 +154,12 @@ def _jumping(model, resolved):
     trial (:func:`_bound_trend`); and the remaining outputs filled from jumps
     at the trial's cost per filled output (the writing itself is
     :func:`_writing`'s). Never more than ``resolved``."""
+    from .jumps import compile_kernels
     from .simulate import run
     from .wear import GROWTH
 
+    if model.scene.wear.jump == "implicit":
+        compile_kernels()            # as the loop's kernels are, before the timing
     state = initial_state(model)
     start = time.perf_counter()
     budget = min(JUMP_TRIAL, resolved)
