@@ -382,7 +382,8 @@ def test_a_stiff_vertex_jumped_at_its_settled_rate_follows_its_contact(jumps_per
     durations"): jumped by ``J (r_c + phi (r - r_c))`` with the settled rate
     from its depth's and rate's change between measurements, its error
     decays whatever ``J g``; from the mean of its last two rates instead
-    (this model's own instability) it grows once ``J g`` passes about 2."""
+    (this model's own instability) it stops decaying once ``J g`` reaches
+    about 2 (it stays at a third at 3) and grows beyond."""
     error = _stiff_vertex(jumps_per_g, settled=True)
     assert error[-1] < 1e-6 and error[-1] <= error[0]
     if jumps_per_g >= 3.0:
