@@ -108,6 +108,10 @@ class BodyJump:
     gamma: np.ndarray = None  # (k,) worn counter-parts' wear under it per cycle per unit
                               # of ``mean`` (1 / cycle), or None
     counter: np.ndarray = None  # (k,) that wear per cycle (m), or None
+    feet: dict = None        # per worn counter-part j: the barycentric weights (k, 3) of
+                             # each vertex's foot at the cycle's end on the face it is
+                             # over and that face's corners (k, 3) (rows of vertices over
+                             # none: zero), for :func:`counter_factors`
 
 
 def start_depths(model, body, s):
@@ -282,6 +286,7 @@ def counter_relief(model, s, m, increments, t):
     at the vertex's foot on the face it is over at ``t`` (the end of the
     cycle), and that per unit mean penetration."""
     counter = np.zeros(len(m.index))
+    m.feet = {}
     for j, (surface, increment) in enumerate(zip(model.surfaces.per_vertex, increments)):
         if increment is None:
             continue
@@ -291,6 +296,8 @@ def counter_relief(model, s, m, increments, t):
             continue
         weights, corners = surface.face_weights(vertex_feet(s, j, m.index[on]), face[on], t)
         counter[on] += np.einsum("ij,ij->i", weights, increment[corners])
+        m.feet[j] = (np.zeros((len(on), 3)), np.zeros((len(on), 3), np.int64))
+        m.feet[j][0][on], m.feet[j][1][on] = weights, corners
     m.counter = counter
     m.gamma = np.where(m.mean > 0.0, counter / np.where(m.mean > 0.0, m.mean, 1.0), 0.0)
 
@@ -377,7 +384,12 @@ def counter_factors(model, state, measures, results, rates, jump, increments, t,
             own = rate[index[on]] * jump
             factor = wear[index[on]] / own
             relative = estimate[index[on]] / own
-            weights, corners = surface.face_weights(vertex_feet(s, j, index[on]), face[on], t)
+            if m.feet is not None and j in m.feet:
+                # (the feet counter_relief found at the same state)
+                weights, corners = m.feet[j][0][on], m.feet[j][1][on]
+            else:
+                weights, corners = surface.face_weights(vertex_feet(s, j, index[on]), face[on],
+                                                        t)
             # each vertex weighs by its own wear in the cycle, which the same
             # contact gave the counter too (by the counter's wear under it, a
             # vertex that barely wore but jumps far, one just entering the

@@ -28,8 +28,9 @@ the bodies: its wear in the resolved cycle relieves the body vertices over it
 in the implicit step (:func:`meshwear.jumps.counter_relief`), and its own
 wear over the ``J`` cycles is relieved as theirs is (the same contact wears
 both: :func:`meshwear.jumps.counter_factors`; a vertex that relaxes faster on
-its own, by its stiffness summed in the wear kernel, jumps by the mean of its
-last two rates where the jump outlasts that relaxation), ``J`` bounded by the
+its own, by its stiffness summed in the wear kernel, jumps at the rate it
+settles to, :func:`meshwear.jumps.settled_rates`, its departure from it
+relaxing over the jump on its own), ``J`` bounded by the
 bodies' implicit step, by the sampling noise of the counter's wear per cycle and by
 a fraction of its mesh spacing
 (:data:`meshwear.kernels.counter_wear.SPACING_FRACTION`) per jump.
