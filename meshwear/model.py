@@ -235,6 +235,8 @@ class PartState:
         How much each vertex's wear falls per unit of its own depth, summed
         over the steps since it was zeroed (kept for implicit cycle jumps;
         (0,): not kept).
+    place : (V,) int64
+        Where each lagging vertex is in ``touched``.
     """
 
     vertices: np.ndarray
@@ -248,6 +250,7 @@ class PartState:
     due: np.ndarray
     count: np.ndarray
     stiffness: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    place: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
     @classmethod
     def unworn(cls, surface, stiffness=False):
@@ -258,7 +261,7 @@ class PartState:
                    depth=np.zeros(n), volume=np.zeros(n), work=np.zeros(n), added=np.zeros(n),
                    touched=np.zeros(n, np.int64), limit=np.full(n, np.inf),
                    due=np.zeros(n, np.int64), count=np.zeros(1, np.int64),
-                   stiffness=np.zeros(n if stiffness else 0))
+                   stiffness=np.zeros(n if stiffness else 0), place=np.zeros(n, np.int64))
 
 
 @dataclass(eq=False)

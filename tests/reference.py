@@ -466,7 +466,7 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
     half their spacing since they last moved (the kernel returns the first
     of them)."""
     (counter_law, faces, reference, normals, tributary, spacing, _, _, vertices, frames, depth,
-     volume, work, added, _, limit, _, _, stiffness) = part
+     volume, work, added, _, limit, _, _, stiffness, _) = part
     code, k = int(counter_law[0]), counter_law[1]
     f, dt, dt0, dt1 = law[0], law[4], law[11], law[12]
     R = quaternion_matrix(pose[3:7])
@@ -518,7 +518,7 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
 def settle_counter(part):
     """Twin of :func:`meshwear.kernels.counter_wear.settle_counter`."""
     (_, faces, reference, normals, _, _, _, _, vertices, frames, depth, _, _, added, _, limit,
-     _, _, _) = part
+     _, _, _, _) = part
     moved = added > 0.0
     vertices[moved] = reference[moved] - depth[moved, None] * normals[moved]
     added[moved] = 0.0

@@ -14,6 +14,7 @@ import cases
 import reference
 from meshwear import checkpoint, jumps
 from meshwear.cli import main
+from meshwear.kernels import counter_wear
 from meshwear.kernels.counter_wear import settle_counter, wear_counter
 from meshwear.model import build_model, initial_state
 from meshwear.scene import SceneError, load_scene
@@ -87,7 +88,7 @@ def test_kernel_matches_its_numpy_twin(tmp_path):
     twin_tuple = (disc.law, disc.faces, disc.reference_vertices, disc.vertex_normals,
                   disc.tributary, disc.spacing, None, None, twin.vertices, twin.frames,
                   twin.depth, twin.volume, twin.work, twin.added, twin.touched, twin.limit,
-                  twin.due, twin.count, twin.stiffness)
+                  twin.due, twin.count, twin.stiffness, twin.place)
 
     def same():
         for name in ("depth", "volume", "work", "vertices", "added", "limit", "stiffness"):
@@ -117,6 +118,9 @@ def test_kernel_matches_its_numpy_twin(tmp_path):
                                    - (part.depth - part.added)[lagging, None]
                                    * disc.vertex_normals[lagging], rtol=0, atol=1e-15)
         assert set(part.touched[:part.count[0]]) == set(np.flatnonzero(lagging))
+        # each lagging vertex knows its place in the list (a moving one leaves it)
+        lagging_list = part.touched[:part.count[0]]
+        np.testing.assert_array_equal(part.place[lagging_list], np.arange(part.count[0]))
         if lagged and moved:
             break
     assert (part.depth > depth0).sum() > 10
@@ -128,6 +132,43 @@ def test_kernel_matches_its_numpy_twin(tmp_path):
     assert part.count[0] == 0 and not part.added.any() and np.isinf(part.limit).all()
     np.testing.assert_allclose(part.vertices, disc.reference_vertices
                                - part.depth[:, None] * disc.vertex_normals, rtol=0, atol=1e-15)
+
+
+def test_the_threaded_builds_give_the_serial_numbers_bit_for_bit(tmp_path):
+    """The pairs' shares and the refit of moved vertices are computed on
+    threads above a size (counter_wear.PARALLEL_PAIRS, PARALLEL_REFIT); both
+    builds give the same numbers to the last bit."""
+    model = build_model(load_scene(_scene(tmp_path, duration=0.1)))
+    state = run(model, initial_state(model))
+    disc, part, s, body = model.surfaces.per_vertex[0], state.parts[0], state.bodies[0], \
+        model.bodies[0]
+    rotation, frame = disc.frame(state.time)
+    args = (s.vertices, s.pose, s.active, body.area_vectors, model.law, s.contact_state[0],
+            s.normal_force[0], s.vertex_planes[0], s.hint[0], rotation, frame, disc.law,
+            disc.faces, part.vertices)
+    shares = []
+    for kernel in (counter_wear._pairs_serial, counter_wear._pairs_parallel):
+        at, pairs = np.full(len(s.active), -7), np.full((len(s.active), 6), np.nan)
+        kernel(*args, at, pairs)
+        shares.append((at, pairs[at >= 0]))
+    assert (shares[0][0] >= 0).sum() > 100, "the case must have pairs"
+    np.testing.assert_array_equal(shares[0][0], shares[1][0])
+    np.testing.assert_array_equal(shares[0][1], shares[1][1])
+    # every worn vertex moved to its depth again, its faces fitted anew
+    moved = np.flatnonzero(part.depth > 0.0)
+    assert len(moved) > counter_wear.PARALLEL_REFIT
+    marks = np.full(len(part.depth), np.inf)
+    marks[moved] = -1.0
+    fitted = []
+    for kernel in (counter_wear._refit_serial, counter_wear._refit_parallel):
+        vertices, frames = disc.reference_vertices.copy(), np.zeros_like(part.frames)
+        kernel(moved, len(moved), marks, disc.reference_vertices, part.depth,
+               disc.vertex_normals, vertices, disc.faces, frames, disc.vertex_face_starts,
+               disc.vertex_face_items)
+        fitted.append((vertices, frames))
+    np.testing.assert_array_equal(fitted[0][0], fitted[1][0])
+    np.testing.assert_array_equal(fitted[0][1], fitted[1][1])
+    assert np.abs(fitted[0][1]).sum() > 0.0
 
 
 def test_both_parts_wear_their_coefficient_times_load_times_sliding(two_turns, measured):

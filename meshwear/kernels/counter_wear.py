@@ -45,7 +45,8 @@ part : tuple
     (``w`` its weight, ``dV`` the pair's volume, ``delta`` its
     penetration, ``A`` the vertex's tributary area), by how much its wear in
     the step falls per unit of its own depth (docs/model.md, "Long
-    durations").
+    durations"), then where each lagging vertex is in the lagging list
+    (V,) int64, so that one that moves leaves it at once.
 """
 
 import numpy as np
@@ -57,14 +58,14 @@ from .nearest import closest_on_triangle
 
 PART_FIELDS = ("law", "faces", "reference", "normals", "tributary", "spacing", "starts", "items",
                "vertices", "frames", "depth", "volume", "work", "added", "touched", "limit",
-               "due", "count", "stiffness")
+               "due", "count", "stiffness", "place")
 
 #: the part tuple of a surface that does not wear
 NO_PART = (np.array([-1.0, 0.0]), np.zeros((0, 3), np.int64), np.zeros((0, 3)), np.zeros((0, 3)),
            np.zeros(0), np.zeros(0), np.zeros(1, np.int64), np.zeros(0, np.int64),
            np.zeros((0, 3)), np.zeros((0, 4, 4)), np.zeros(0), np.zeros(0), np.zeros(0),
            np.zeros(0), np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.int64),
-           np.zeros(1, np.int64), np.zeros(0))
+           np.zeros(1, np.int64), np.zeros(0), np.zeros(0, np.int64))
 
 #: a counter vertex may sink by at most this fraction of its shortest edge in
 #: one step; deeper, its faces could fold over
@@ -75,9 +76,12 @@ SPACING_FRACTION = 0.5
 #: shortest edge, if smaller)
 LAG_FRACTION = 1e-2
 
+#: active vertices from which the pairs' shares are computed on threads
+PARALLEL_PAIRS = 2048
+
 #: moved counter vertices from which their faces are fitted anew on threads
 #: (a fine worn flat under a pad: 5 000 vertices, 12 000 faces a step)
-PARALLEL_REFIT = 1024
+PARALLEL_REFIT = 32
 
 
 @njit(cache=True, inline="always")
@@ -111,18 +115,14 @@ def _face_frame(vertices, faces, f, frames):
     _edge_line(frames, f, 3, cx, cy, cz, ax, ay, az, nx, ny, nz)
 
 
-@njit(cache=True)
-def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_force, planes,
-                 hint, rotation, frame, part):
-    """Wear the counter-part ``part`` by every pair of the step just taken
-    (``contact_state``, ``normal_force``: this surface's rows), and move the
-    vertices whose lag reached their limit. Returns -1, or the first counter
-    vertex that sank deeper than :data:`SPACING_FRACTION` of its spacing
-    since it last moved (the step is done all the same: the caller stops the
-    run)."""
-    (counter_law, faces, reference, normals, tributary, spacing, starts, items, vertices, frames,
-     depth, volume, work, added, touched, limit, due, lagging, stiffness) = part
-    keep_stiffness = stiffness.shape[0] > 0
+def _pairs(body_vertices, pose, active, area, law, contact_state, normal_force, planes, hint,
+           rotation, frame, counter_law, faces, vertices, at, pairs):
+    """Each pair's share of the step's wear on the counter, by slot of
+    ``active``: ``at`` the face under it (-1: it wears nothing) and ``pairs``
+    (m, 6) the barycentric weights of its contact point on that face, its
+    dissipated energy (J), its worn volume (m³) and its signed distance to
+    the plane (m). Each pair on its own: the threaded build computes them on
+    threads, and :func:`wear_counter` adds them up in slot order."""
     code, k_counter = int(counter_law[0]), counter_law[1]
     f, dt = law[0], law[4]
     dt0, dt1 = law[11], law[12]
@@ -130,8 +130,8 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
     cx, cy, cz = pose[0], pose[1], pose[2]
     vx, vy, vz = pose[7], pose[8], pose[9]
     wx, wy, wz = pose[10], pose[11], pose[12]
-    count = lagging[0]
-    for slot in range(active.shape[0]):
+    for slot in prange(active.shape[0]):
+        at[slot] = -1
         i = active[slot]
         state = contact_state[i]
         load = normal_force[i]
@@ -183,6 +183,45 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
             qx, qy, qz, vertices[j0, 0], vertices[j0, 1], vertices[j0, 2],
             vertices[j1, 0], vertices[j1, 1], vertices[j1, 2],
             vertices[j2, 0], vertices[j2, 1], vertices[j2, 2])[3:6]
+        at[slot] = face
+        pairs[slot, 0], pairs[slot, 1], pairs[slot, 2] = weights
+        pairs[slot, 3], pairs[slot, 4], pairs[slot, 5] = energy, dv, delta
+
+
+_pairs_serial = njit(cache=True)(_named_copy(_pairs, "_pairs_serial"))
+_pairs_parallel = njit(cache=True, parallel=True)(_named_copy(_pairs, "_pairs_parallel"))
+
+
+@njit(cache=True)
+def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_force, planes,
+                 hint, rotation, frame, part):
+    """Wear the counter-part ``part`` by every pair of the step just taken
+    (``contact_state``, ``normal_force``: this surface's rows), and move the
+    vertices whose lag reached their limit. Returns -1, or the first counter
+    vertex that sank deeper than :data:`SPACING_FRACTION` of its spacing
+    since it last moved (the step is done all the same: the caller stops the
+    run)."""
+    (counter_law, faces, reference, normals, tributary, spacing, starts, items, vertices, frames,
+     depth, volume, work, added, touched, limit, due, lagging, stiffness, place) = part
+    keep_stiffness = stiffness.shape[0] > 0
+    m = active.shape[0]
+    at = np.empty(m, np.int64)
+    pairs = np.empty((m, 6))
+    if m >= PARALLEL_PAIRS:
+        _pairs_parallel(body_vertices, pose, active, area, law, contact_state, normal_force,
+                        planes, hint, rotation, frame, counter_law, faces, vertices, at, pairs)
+    else:
+        _pairs_serial(body_vertices, pose, active, area, law, contact_state, normal_force,
+                      planes, hint, rotation, frame, counter_law, faces, vertices, at, pairs)
+    count = lagging[0]
+    moving = 0
+    deep = False
+    for slot in range(m):
+        face = at[slot]
+        if face < 0:
+            continue
+        weights = (pairs[slot, 0], pairs[slot, 1], pairs[slot, 2])
+        energy, dv, delta = pairs[slot, 3], pairs[slot, 4], pairs[slot, 5]
         for corner in range(3):
             j = faces[face, corner]
             share = weights[corner]
@@ -193,7 +232,9 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
                 volume[j] += share * dv
                 sink = share * dv / tributary[j]
                 depth[j] += sink
-                if added[j] == 0.0:
+                if limit[j] == np.inf:
+                    # it starts lagging (limit inf: it was not)
+                    place[j] = count
                     touched[count] = j
                     count += 1
                 added[j] += sink
@@ -201,16 +242,33 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
                 lag = LAG_FRACTION * min(-delta, spacing[j])
                 if lag < limit[j]:
                     limit[j] = lag
+                if added[j] >= limit[j] and limit[j] > -np.inf:
+                    # its lag reached its limit: it moves after the step
+                    # (limit -inf marks it for _refit)
+                    due[moving] = j
+                    moving += 1
+                    limit[j] = -np.inf
+                deep = deep or added[j] > SPACING_FRACTION * spacing[j]
                 if keep_stiffness and delta < 0.0:
                     stiffness[j] -= share * sink / delta
-    lagging[0] = count
     worst = -1
-    for c in range(count):
-        j = touched[c]
-        if added[j] > SPACING_FRACTION * spacing[j]:
-            worst = j
-            break
-    _move(part, False)
+    if deep:
+        for c in range(count):
+            j = touched[c]
+            if added[j] > SPACING_FRACTION * spacing[j]:
+                worst = j
+                break
+    # the moving vertices leave the lagging list (the last one takes each
+    # one's place), so a step's bookkeeping is on its own pairs, not on all
+    # the lagging vertices
+    for c in range(moving):
+        j = due[c]
+        count -= 1
+        last = touched[count]
+        touched[place[j]] = last
+        place[last] = place[j]
+    lagging[0] = count
+    _move(part, moving)
     return worst
 
 
@@ -218,27 +276,22 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
 def settle_counter(part):
     """Move every lagging vertex of counter-part ``part`` to its depth (its
     faces fitted anew): the counter where its depth puts it."""
-    _move(part, True)
+    touched, limit, due, lagging = part[14], part[15], part[16], part[17]
+    count = lagging[0]
+    for c in range(count):
+        j = touched[c]
+        due[c] = j
+        limit[j] = -np.inf           # (marks the vertices moving now for _refit)
+    lagging[0] = 0
+    _move(part, count)
 
 
 @njit(cache=True)
-def _move(part, every):
-    """Move the lagging vertices whose lag reached their limit (``every``:
-    all of them) to their depth and fit their faces anew; the others keep
-    lagging."""
+def _move(part, moving):
+    """Move the first ``moving`` vertices of ``due`` (their limit -inf) to
+    their depth and fit their faces anew."""
     (_, faces, reference, normals, _, _, starts, items, vertices, frames, depth, _, _, added,
-     touched, limit, due, lagging, _) = part
-    count, kept, moving = lagging[0], 0, 0
-    for c in range(count):
-        j = touched[c]
-        if every or added[j] >= limit[j]:
-            due[moving] = j
-            moving += 1
-            limit[j] = -1.0           # (marks the vertices moving now for _refit)
-        else:
-            touched[kept] = j
-            kept += 1
-    lagging[0] = kept
+     _, limit, due, _, _, _) = part
     if moving >= PARALLEL_REFIT:
         _refit_parallel(due, moving, limit, reference, depth, normals, vertices, faces,
                         frames, starts, items)

@@ -38,7 +38,6 @@ import numpy as np
 from numba import njit, prange
 
 from .contact import _named_copy, rotation_entries  # noqa: F401  (re-exported for twins)
-from .frames import to_frame
 from .tree import STACK, box_distance2
 
 #: faces a vertex that moved off its face walks across to find the one it is
@@ -160,13 +159,27 @@ def _consider(f, yx, yy, yz, frames, faces, counter_vertices, reach2, over, grow
     of the walk from the vertex's last face, which it may stay on however
     far; the others only if no farther than the nearest face or the kept one."""
     delta = _along(frames, f, 0, yx, yy, yz)
-    plane2 = delta * delta
-    if plane2 > reach2:
+    if delta * delta > reach2:
         return best, best_d2, best_delta, kept, kept_d2, kept_delta
     # how far the foot of y on the plane lies outside the triangle's
     # edges: its distance to the face is at least that
     outside = max(_along(frames, f, 1, yx, yy, yz), _along(frames, f, 2, yx, yy, yz),
                   _along(frames, f, 3, yx, yy, yz))
+    return _consider_at(f, delta, outside, yx, yy, yz, frames, faces, counter_vertices, reach2,
+                        over, grow, tracked, tx, ty, tz, walked, best, best_d2, best_delta, kept,
+                        kept_d2, kept_delta)
+
+
+@njit(cache=True, inline="always")
+def _consider_at(f, delta, outside, yx, yy, yz, frames, faces, counter_vertices, reach2, over,
+                 grow, tracked, tx, ty, tz, walked, best, best_d2, best_delta, kept, kept_d2,
+                 kept_delta):
+    """:func:`_consider` given the vertex's signed distance to face ``f``'s
+    plane (``delta``) and how far its foot lies past the face's nearest edge
+    (``outside``), as the walk has them."""
+    plane2 = delta * delta
+    if plane2 > reach2:
+        return best, best_d2, best_delta, kept, kept_d2, kept_delta
     bound = plane2 + outside * outside if outside > 0.0 else plane2
     if bound > reach2 or (bound > best_d2 * grow
                           and (not (tracked and (walked or kept >= 0)) or bound > kept_d2 * grow)):
@@ -234,7 +247,8 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
         # the previous normal in the counter frame
         tx, ty, tz = 0.0, 0.0, 0.0
         if tracked and not (fixed and flat):
-            tx, ty, tz = to_frame(rotation, ox, oy, oz)
+            tx, ty, tz = (q00 * ox + q10 * oy + q20 * oz, q01 * ox + q11 * oy + q21 * oz,
+                          q02 * ox + q12 * oy + q22 * oz)
         # the nearest face, and the nearest of the faces the vertex can stay
         # on (within TRACKING of its last normal, and with the vertex over
         # it, not beyond its edges: past a convex edge the vertex lets go)
@@ -243,13 +257,17 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
         best_delta = kept_delta = -np.inf
         by_hint = onto = False
         h = hint[i]
+        # (the foot's distances past the edges of face h, for the walk)
+        a0 = a1 = a2 = 0.0
         if tracked and h >= 0:
             # still over the face it had, within reach and TRACKING: it stays
             # there, no search (the search would pick it too, unless the
             # vertex is over two such faces at once, at a concave fold)
             delta = _along(frames, h, 0, yx, yy, yz)
-            outside = max(_along(frames, h, 1, yx, yy, yz), _along(frames, h, 2, yx, yy, yz),
-                          _along(frames, h, 3, yx, yy, yz))
+            a0 = _along(frames, h, 1, yx, yy, yz)
+            a1 = _along(frames, h, 2, yx, yy, yz)
+            a2 = _along(frames, h, 3, yx, yy, yz)
+            outside = max(a0, a1, a2)
             # (a flat face of a surface that does not turn in its frame: the
             # normal the vertex holds is that face's own, TRACKING holds)
             if (delta * delta <= reach2 and outside <= over
@@ -260,25 +278,31 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
                 by_hint = True
         if kept < 0:
             if tracked and fixed and flat:
-                tx, ty, tz = to_frame(rotation, ox, oy, oz)
+                tx, ty, tz = (q00 * ox + q10 * oy + q20 * oz, q01 * ox + q11 * oy + q21 * oz,
+                              q02 * ox + q12 * oy + q22 * oz)
             if tracked and h >= 0:
                 # it has moved off its face: walk across the edge its foot is
                 # farthest beyond, face by face while they keep within
                 # TRACKING, to the face it is over now (WALK faces at most)
                 f = h
                 back, back_beyond = -1, 0.0
-                for _ in range(WALK):
-                    edge, beyond = 0, _along(frames, f, 1, yx, yy, yz)
-                    for e in range(1, 3):
-                        a = _along(frames, f, e + 1, yx, yy, yz)
-                        if a > beyond:
-                            edge, beyond = e, a
+                for step in range(WALK):
+                    if step > 0:
+                        a0 = _along(frames, f, 1, yx, yy, yz)
+                        a1 = _along(frames, f, 2, yx, yy, yz)
+                        a2 = _along(frames, f, 3, yx, yy, yz)
+                    edge, beyond = 0, a0
+                    if a1 > beyond:
+                        edge, beyond = 1, a1
+                    if a2 > beyond:
+                        edge, beyond = 2, a2
                     if beyond <= over:
                         # over it: it stays there, as on its own face, if it
                         # may (TRACKING, reach) and is not deep under it
-                        best, best_d2, best_delta, kept, kept_d2, kept_delta = _consider(
-                            f, yx, yy, yz, frames, faces, counter_vertices, reach2, over, grow,
-                            tracked, tx, ty, tz, True, best, best_d2, best_delta, kept, kept_d2,
+                        best, best_d2, best_delta, kept, kept_d2, kept_delta = _consider_at(
+                            f, _along(frames, f, 0, yx, yy, yz), max(a0, a1, a2), yx, yy, yz,
+                            frames, faces, counter_vertices, reach2, over, grow, tracked,
+                            tx, ty, tz, True, best, best_d2, best_delta, kept, kept_d2,
                             kept_delta)
                         if kept == f and not _released(frames, neighbours, f, kept_delta,
                                                        beyond, yx, yy, yz):
@@ -396,12 +420,12 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             py = ey + o1 - best_delta * oy
             pz = ez + o2 - best_delta * oz
         else:
-            px = rotation[0, 0] * qx + rotation[0, 1] * qy + rotation[0, 2] * qz + o0
-            py = rotation[1, 0] * qx + rotation[1, 1] * qy + rotation[1, 2] * qz + o1
-            pz = rotation[2, 0] * qx + rotation[2, 1] * qy + rotation[2, 2] * qz + o2
-            out[i, 1, 0] = rotation[0, 0] * hx + rotation[0, 1] * hy + rotation[0, 2] * hz
-            out[i, 1, 1] = rotation[1, 0] * hx + rotation[1, 1] * hy + rotation[1, 2] * hz
-            out[i, 1, 2] = rotation[2, 0] * hx + rotation[2, 1] * hy + rotation[2, 2] * hz
+            px = q00 * qx + q01 * qy + q02 * qz + o0
+            py = q10 * qx + q11 * qy + q12 * qz + o1
+            pz = q20 * qx + q21 * qy + q22 * qz + o2
+            out[i, 1, 0] = q00 * hx + q01 * hy + q02 * hz
+            out[i, 1, 1] = q10 * hx + q11 * hy + q12 * hz
+            out[i, 1, 2] = q20 * hx + q21 * hy + q22 * hz
         out[i, 0, 0], out[i, 0, 1], out[i, 0, 2] = px, py, pz
         lx, ly, lz = px - c0, py - c1, pz - c2
         out[i, 2, 0] = v0 + w1 * lz - w2 * ly

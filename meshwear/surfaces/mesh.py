@@ -267,7 +267,8 @@ class MeshSurface(CounterSurface):
         return (self.law, self.faces, self.reference_vertices, self.vertex_normals,
                 self.tributary, self.spacing, self.vertex_face_starts, self.vertex_face_items,
                 part.vertices, part.frames, part.depth, part.volume, part.work, part.added,
-                part.touched, part.limit, part.due, part.count, part.stiffness)
+                part.touched, part.limit, part.due, part.count, part.stiffness,
+                part.place)
 
     # ------------------------------------------------------------ the interface
     def ensure_reach(self, reach):
