@@ -207,6 +207,42 @@ def _consider_at(f, delta, outside, yx, yy, yz, frames, faces, counter_vertices,
     return best, best_d2, best_delta, kept, kept_d2, kept_delta
 
 
+def _tree_search(yx, yy, yz, frames, faces, counter_vertices, boxes, nodes, order, reach2, over,
+                 grow, tracked, tx, ty, tz, best, best_d2, best_delta, kept, kept_d2, kept_delta):
+    """The faces of the tree's nodes whose boxes come within reach and nearer
+    than the faces found (:func:`_consider`), nearer child first: best and
+    kept, updated. Out of the query's loop (a vertex that walked onto its
+    face needs none), so that the loop stays small."""
+    stack = np.empty(STACK, np.int64)
+    stack[0] = 0
+    top = 1
+    while top > 0:
+        top -= 1
+        node = stack[top]
+        bound = box_distance2(boxes, node, yx, yy, yz)
+        if bound > reach2 or (bound > best_d2 * grow
+                              and (kept < 0 or bound > kept_d2 * grow)):
+            continue
+        first, count = nodes[node, 0], nodes[node, 1]
+        if count > 0:
+            for e in range(first, first + count):
+                best, best_d2, best_delta, kept, kept_d2, kept_delta = _consider(
+                    order[e], yx, yy, yz, frames, faces, counter_vertices, reach2,
+                    over, grow, tracked, tx, ty, tz, False, best, best_d2,
+                    best_delta, kept, kept_d2, kept_delta)
+            continue
+        near = box_distance2(boxes, first, yx, yy, yz)
+        far = box_distance2(boxes, first + 1, yx, yy, yz)
+        if near <= far:
+            stack[top] = first + 1
+            stack[top + 1] = first
+        else:
+            stack[top] = first
+            stack[top + 1] = first + 1
+        top += 2
+    return best, best_d2, best_delta, kept, kept_d2, kept_delta
+
+
 def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
                     frames, corner_normals, search, boxes, nodes, order, neighbours, out,
                     distance, hint, fixed, steady):
@@ -339,33 +375,10 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             # stay on it), nearer child first
             if (not onto and boxes.shape[0] > 0
                     and box_distance2(boxes, 0, yx, yy, yz) <= reach2):
-                stack = np.empty(STACK, np.int64)
-                stack[0] = 0
-                top = 1
-                while top > 0:
-                    top -= 1
-                    node = stack[top]
-                    bound = box_distance2(boxes, node, yx, yy, yz)
-                    if bound > reach2 or (bound > best_d2 * grow
-                                          and (kept < 0 or bound > kept_d2 * grow)):
-                        continue
-                    first, count = nodes[node, 0], nodes[node, 1]
-                    if count > 0:
-                        for e in range(first, first + count):
-                            best, best_d2, best_delta, kept, kept_d2, kept_delta = _consider(
-                                order[e], yx, yy, yz, frames, faces, counter_vertices, reach2,
-                                over, grow, tracked, tx, ty, tz, False, best, best_d2,
-                                best_delta, kept, kept_d2, kept_delta)
-                        continue
-                    near = box_distance2(boxes, first, yx, yy, yz)
-                    far = box_distance2(boxes, first + 1, yx, yy, yz)
-                    if near <= far:
-                        stack[top] = first + 1
-                        stack[top + 1] = first
-                    else:
-                        stack[top] = first
-                        stack[top + 1] = first + 1
-                    top += 2
+                best, best_d2, best_delta, kept, kept_d2, kept_delta = _search_tree(
+                    yx, yy, yz, frames, faces, counter_vertices, boxes, nodes, order, reach2,
+                    over, grow, tracked, tx, ty, tz, best, best_d2, best_delta, kept, kept_d2,
+                    kept_delta)
             if kept >= 0 and not walked and kept_d2 > best_d2 * grow:
                 kept = -1               # not reached by the walk, and not the nearest
         if (kept >= 0 and not by_hint and not onto and kept_delta < 0.0 and best >= 0
@@ -454,6 +467,8 @@ def face_frames(vertices, faces):
 
 
 # fastmath "contract" only, as the contact kernel (FMA; IEEE NaN and infinity kept)
+# (the same flags as the queries that call it)
+_search_tree = njit(cache=True, fastmath={"contract"}, error_model="numpy")(_tree_search)
 nearest_planes_serial = njit(cache=True, fastmath={"contract"}, error_model="numpy")(
     _named_copy(_nearest_planes, "nearest_planes_serial"))
 nearest_planes_parallel = njit(cache=True, parallel=True, fastmath={"contract"},
