@@ -38,6 +38,7 @@ import numpy as np
 from numba import njit, prange
 
 from .contact import _named_copy, rotation_entries  # noqa: F401  (re-exported for twins)
+from .frames import to_frame
 from .tree import STACK, box_distance2
 
 #: faces a vertex that moved off its face walks across to find the one it is
@@ -283,8 +284,7 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
         # the previous normal in the counter frame
         tx, ty, tz = 0.0, 0.0, 0.0
         if tracked and not (fixed and flat):
-            tx, ty, tz = (q00 * ox + q10 * oy + q20 * oz, q01 * ox + q11 * oy + q21 * oz,
-                          q02 * ox + q12 * oy + q22 * oz)
+            tx, ty, tz = to_frame(rotation, ox, oy, oz)
         # the nearest face, and the nearest of the faces the vertex can stay
         # on (within TRACKING of its last normal, and with the vertex over
         # it, not beyond its edges: past a convex edge the vertex lets go)
@@ -314,8 +314,7 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
                 by_hint = True
         if kept < 0:
             if tracked and fixed and flat:
-                tx, ty, tz = (q00 * ox + q10 * oy + q20 * oz, q01 * ox + q11 * oy + q21 * oz,
-                              q02 * ox + q12 * oy + q22 * oz)
+                tx, ty, tz = to_frame(rotation, ox, oy, oz)
             if tracked and h >= 0:
                 # it has moved off its face: walk across the edge its foot is
                 # farthest beyond, face by face while they keep within
@@ -433,12 +432,12 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
             py = ey + o1 - best_delta * oy
             pz = ez + o2 - best_delta * oz
         else:
-            px = q00 * qx + q01 * qy + q02 * qz + o0
-            py = q10 * qx + q11 * qy + q12 * qz + o1
-            pz = q20 * qx + q21 * qy + q22 * qz + o2
-            out[i, 1, 0] = q00 * hx + q01 * hy + q02 * hz
-            out[i, 1, 1] = q10 * hx + q11 * hy + q12 * hz
-            out[i, 1, 2] = q20 * hx + q21 * hy + q22 * hz
+            px = rotation[0, 0] * qx + rotation[0, 1] * qy + rotation[0, 2] * qz + o0
+            py = rotation[1, 0] * qx + rotation[1, 1] * qy + rotation[1, 2] * qz + o1
+            pz = rotation[2, 0] * qx + rotation[2, 1] * qy + rotation[2, 2] * qz + o2
+            out[i, 1, 0] = rotation[0, 0] * hx + rotation[0, 1] * hy + rotation[0, 2] * hz
+            out[i, 1, 1] = rotation[1, 0] * hx + rotation[1, 1] * hy + rotation[1, 2] * hz
+            out[i, 1, 2] = rotation[2, 0] * hx + rotation[2, 1] * hy + rotation[2, 2] * hz
         out[i, 0, 0], out[i, 0, 1], out[i, 0, 2] = px, py, pz
         lx, ly, lz = px - c0, py - c1, pz - c2
         out[i, 2, 0] = v0 + w1 * lz - w2 * ly
