@@ -236,7 +236,7 @@ class PartState:
         over the steps since it was zeroed (kept for implicit cycle jumps;
         (0,): not kept).
     place : (V,) int64
-        Where each lagging vertex is in ``touched``.
+        Where each lagging vertex is in ``touched``, -1 for the others.
     """
 
     vertices: np.ndarray
@@ -261,7 +261,7 @@ class PartState:
                    depth=np.zeros(n), volume=np.zeros(n), work=np.zeros(n), added=np.zeros(n),
                    touched=np.zeros(n, np.int64), limit=np.full(n, np.inf),
                    due=np.zeros(n, np.int64), count=np.zeros(1, np.int64),
-                   stiffness=np.zeros(n if stiffness else 0), place=np.zeros(n, np.int64))
+                   stiffness=np.zeros(n if stiffness else 0), place=np.full(n, -1, np.int64))
 
 
 @dataclass(eq=False)

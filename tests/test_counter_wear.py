@@ -121,6 +121,7 @@ def test_kernel_matches_its_numpy_twin(tmp_path):
         # each lagging vertex knows its place in the list (a moving one leaves it)
         lagging_list = part.touched[:part.count[0]]
         np.testing.assert_array_equal(part.place[lagging_list], np.arange(part.count[0]))
+        assert (part.place[~lagging] == -1).all()
         if lagged and moved:
             break
     assert (part.depth > depth0).sum() > 10
@@ -130,6 +131,7 @@ def test_kernel_matches_its_numpy_twin(tmp_path):
     reference.settle_counter(twin_tuple)
     same()
     assert part.count[0] == 0 and not part.added.any() and np.isinf(part.limit).all()
+    assert (part.place == -1).all()
     np.testing.assert_allclose(part.vertices, disc.reference_vertices
                                - part.depth[:, None] * disc.vertex_normals, rtol=0, atol=1e-15)
 

@@ -45,8 +45,8 @@ part : tuple
     (``w`` its weight, ``dV`` the pair's volume, ``delta`` its
     penetration, ``A`` the vertex's tributary area), by how much its wear in
     the step falls per unit of its own depth (docs/model.md, "Long
-    durations"), then where each lagging vertex is in the lagging list
-    (V,) int64, so that one that moves leaves it at once.
+    durations"), then where each vertex is in the lagging list (V,) int64,
+    -1 when it does not lag, so that one that moves leaves it at once.
 """
 
 import numpy as np
@@ -232,8 +232,8 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
                 volume[j] += share * dv
                 sink = share * dv / tributary[j]
                 depth[j] += sink
-                if limit[j] == np.inf:
-                    # it starts lagging (limit inf: it was not)
+                if place[j] < 0:
+                    # it starts lagging
                     place[j] = count
                     touched[count] = j
                     count += 1
@@ -267,6 +267,7 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
         last = touched[count]
         touched[place[j]] = last
         place[last] = place[j]
+        place[j] = -1
     lagging[0] = count
     _move(part, moving)
     return worst
@@ -276,12 +277,13 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
 def settle_counter(part):
     """Move every lagging vertex of counter-part ``part`` to its depth (its
     faces fitted anew): the counter where its depth puts it."""
-    touched, limit, due, lagging = part[14], part[15], part[16], part[17]
+    touched, limit, due, lagging, place = part[14], part[15], part[16], part[17], part[19]
     count = lagging[0]
     for c in range(count):
         j = touched[c]
         due[c] = j
         limit[j] = -np.inf           # (marks the vertices moving now for _refit)
+        place[j] = -1
     lagging[0] = 0
     _move(part, count)
 

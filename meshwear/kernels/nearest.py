@@ -208,7 +208,9 @@ def _consider_at(f, delta, outside, yx, yy, yz, frames, faces, counter_vertices,
     return best, best_d2, best_delta, kept, kept_d2, kept_delta
 
 
-def _tree_search(yx, yy, yz, frames, faces, counter_vertices, boxes, nodes, order, reach2, over,
+# (the flags of the queries that call it)
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def _search_tree(yx, yy, yz, frames, faces, counter_vertices, boxes, nodes, order, reach2, over,
                  grow, tracked, tx, ty, tz, best, best_d2, best_delta, kept, kept_d2, kept_delta):
     """The faces of the tree's nodes whose boxes come within reach and nearer
     than the faces found (:func:`_consider`), nearer child first: best and
@@ -466,8 +468,6 @@ def face_frames(vertices, faces):
 
 
 # fastmath "contract" only, as the contact kernel (FMA; IEEE NaN and infinity kept)
-# (the same flags as the queries that call it)
-_search_tree = njit(cache=True, fastmath={"contract"}, error_model="numpy")(_tree_search)
 nearest_planes_serial = njit(cache=True, fastmath={"contract"}, error_model="numpy")(
     _named_copy(_nearest_planes, "nearest_planes_serial"))
 nearest_planes_parallel = njit(cache=True, parallel=True, fastmath={"contract"},
