@@ -281,7 +281,6 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
         increments = [None] * len(state.parts)
         settled = [None] * len(state.parts)
         stiffness = [None] * len(state.parts)     # per cycle, summed in the wear kernel
-        settled_rates = []
         for k, ((j, part), rate) in enumerate(zip(parts, part_rates)):
             increments[j] = settled[j] = rate
             if implicit and len(part.stiffness):
@@ -291,7 +290,6 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                                                  js.part_past[k])
                 js.part_past[k] = (js.part_past[k] + [(middle, depth, rate, stiffness[j])]
                                    )[-HISTORY:]
-            settled_rates.append(settled[j])
             js.part_noise[k] = _counter_noise(js, k, settled[j], middle)
         if parts:
             # (before the relaxation: the counter-part's wear under each
@@ -378,7 +376,7 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                 alpha[m.index] = np.where(m.mean > 0.0, m.alpha, 0.0)
                 js.alpha.append(alpha)
         js.history = (js.history + [(middle, js.alpha if implicit else None,
-                                      settled_rates)])[1 - HISTORY:]
+                                      [settled[j] for j, _ in parts])])[1 - HISTORY:]
         following = window
         if (forced_jump is None and which in NOISY and jump < 2 * window
                 and window < MAX_WINDOW and js.noisy):
