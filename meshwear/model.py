@@ -201,9 +201,10 @@ class BodyState:
     active_wear: np.ndarray = None
     cull: np.ndarray = None
     cull_scratch: object = None
-    #: (2, n) each vertex's total normal force (N) and total squared normal
-    #: force (N²) added up over the steps since they were last zeroed, kept
-    #: while cycles are jumped over; else (2, 0)
+    #: (5, n) each vertex's total normal force (N), total squared normal
+    #: force (N²) and total force vector along the normals (N, world) added
+    #: up over the steps since they were last zeroed, kept while cycles are
+    #: jumped over (:data:`meshwear.jumps.LOAD_ROWS`); else (2, 0)
     load: np.ndarray = field(default_factory=lambda: np.zeros((2, 0)))
     #: (1,) how much nearer (m) the body may come to a surface before its
     #: deepest vertex in contact has to be measured again against its

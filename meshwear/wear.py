@@ -230,8 +230,8 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
     if len(js.drift) != len(model.bodies):
         js.drift = [np.zeros(len(s.wear_depth)) for s in state.bodies]
     for body, s in zip(model.bodies, state.bodies):
-        if s.load.shape[1] != len(s.wear_depth):
-            s.load = np.zeros((2, len(s.wear_depth)))
+        if s.load.shape != (jumps.LOAD_ROWS, len(s.wear_depth)):
+            s.load = np.zeros((jumps.LOAD_ROWS, len(s.wear_depth)))
     while state.step < model.n_steps:
         start = js.cycle_start = state.step
         before = [(s.wear_depth.copy(), s.vertices.copy(), s.wear_volume.copy(),

@@ -452,6 +452,35 @@ def test_the_settled_rate_is_measured_at_least_one_relaxation_back():
     assert jumps.settled_rates(rate, g, np.full(3, 61.0), 20.0, past)[0] == 0.0
 
 
+def test_a_counter_vertex_barely_worn_at_the_cycle_s_end_takes_a_held_vertex_s_relief():
+    """Four counter vertices on a line. At the cycle's end one body vertex
+    is over vertex 0 (its jump wears it as its rate says: factor 1) and one,
+    wearing a millionth as much, over vertex 2 (its jump wears it 50 times
+    its rate: a vertex just entering the contact). Vertex 3, worn in the
+    cycle but under no body at its end, is nearest vertex 2; vertex 1 is
+    worn by neither. Vertices 2 and 3 take vertex 0's relief (the gear
+    pair's wheel took 2.89 from such a vertex on eleven teeth), not 50;
+    vertex 1 keeps its rate."""
+    from types import SimpleNamespace
+
+    surface = SimpleNamespace(reference_vertices=np.array([[0.0, 0, 0], [1.0, 0, 0],
+                                                           [2.0, 0, 0], [2.4, 0, 0]]))
+    model = SimpleNamespace(surfaces=SimpleNamespace(per_vertex=[surface]))
+    state = SimpleNamespace(bodies=[SimpleNamespace(hint=[np.array([0, 1])])])
+    corners = np.array([[0, 1, 2], [2, 1, 0]])
+    weights = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    m = SimpleNamespace(index=np.array([0, 1]), counter=np.array([1.0, 1.0]),
+                        feet={0: (weights, corners)})
+    rate = np.array([1.0, 1e-6])
+    jump = 10.0
+    wear = np.array([1.0, 50.0]) * rate * jump
+    results = [(wear, None, np.zeros(2))]
+    increment = np.array([1.0, 0.0, 1.0, 1.0])
+    (factor, _), = jumps.counter_factors(model, state, [m], results, [rate], jump,
+                                          [increment], 0.0)
+    np.testing.assert_allclose(factor, [1.0, 1.0, 1.0, 1.0], rtol=1e-12)
+
+
 def test_a_stiff_counter_vertex_jumps_at_the_rate_it_settles_to(monkeypatch):
     """A cylinder fretting on a worn flat, jumped: each measurement hands
     the jump each flat vertex's own stiffness (its wear's fall per unit of

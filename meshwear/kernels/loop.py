@@ -85,8 +85,9 @@ def _fill(body, planes, surfaces, t, buffer, rotation, frame):
 
 
 def _touch(body, plane_array):
-    """One step of the contact kernel; the normal forces and their squares
-    added to ``load``."""
+    """One step of the contact kernel; the normal forces, their squares and
+    their vectors (along each slot's normal) added to ``load``
+    (:data:`meshwear.jumps.LOAD_ROWS`)."""
     (vertices, pose, area, law, wear_direction, contact_state, tangential, normal_force,
      friction_work, wear_depth, wear_volume, wrench, vertex_planes, hint, active, active_wear,
      cull, distance, load, radius, depth_limit, impact_room) = body
@@ -100,13 +101,24 @@ def _touch(body, plane_array):
                        wear_direction, contact_state, tangential, normal_force, friction_work,
                        wear_depth, wear_volume, wrench)
     if load.shape[1]:
+        n_planes = plane_array.shape[0]
         for k in range(active.shape[0]):
             i = active[k]
-            total = 0.0
+            total = fx = fy = fz = 0.0
             for s in range(slots):
-                total += normal_force[s, i]
+                f = normal_force[s, i]
+                if f > 0.0:
+                    total += f
+                    _, _, _, nx, ny, nz = plane_under(plane_array, vertex_planes, n_planes, s,
+                                                      i)
+                    fx += f * nx
+                    fy += f * ny
+                    fz += f * nz
             load[0, i] += total
             load[1, i] += total * total
+            load[2, i] += fx
+            load[3, i] += fy
+            load[4, i] += fz
 
 
 @njit(cache=True)
