@@ -15,13 +15,21 @@ import numpy as np
 from . import stepper
 from .model import initial_state
 
-#: steps timed for the per-step cost at most, and the wall time (s) after
+#: steps timed for the per-step cost at least, and the wall time (s) after
 #: which the trial stops sooner (steps of seconds: a fine worn mesh)
 TRIAL_STEPS, TRIAL_SECONDS = 200, 2.0
+#: the trial goes on past TRIAL_STEPS until this wall time (s), or the
+#: run's end: the first steps may not be the run's (a tossed cube's 200
+#: steps in flight cost a tenth of its steps on the floor, and its
+#: estimate was a third short)
+TRIAL_LEAST = 0.5
 #: wall time (s) a cycle-jumping run is tried for, and longer, up to
 #: JUMP_TRIAL_LONGEST, until bounds other than growth have set BOUNDED_JUMPS
 #: jumps (what the rest of the run's jumps are extrapolated from)
 JUMP_TRIAL, JUMP_TRIAL_LONGEST, BOUNDED_JUMPS = 3.0, 10.0, 8
+#: one-step spans of the compiled loop timed, each with the state's check, for
+#: what the run's returns to Python cost beyond their steps (:func:`_returns`)
+RETURNS = 20
 #: measurements the controller takes before its noise bounds let a first
 #: jump through (a vertex's scatter is fitted over three:
 #: :func:`meshwear.wear._counter_noise`)
@@ -66,7 +74,8 @@ def estimate_run(model, state=None):
     start = time.perf_counter()
     stepper.advance(model, state, warm)
     load = time.perf_counter() - start
-    trial = min(model.n_steps - warm, TRIAL_STEPS)
+    # (leaving the steps the returns to Python are timed on)
+    trial = max(1, model.n_steps - warm - RETURNS)
     done, chunk = 0, 1
     start = time.perf_counter()
     while done < trial:             # in doubling chunks, until TRIAL_SECONDS
@@ -74,20 +83,41 @@ def estimate_run(model, state=None):
         stepper.advance(model, state, warm + done + chunk)
         done += chunk
         chunk *= 2
-        if time.perf_counter() - start > TRIAL_SECONDS:
+        elapsed = time.perf_counter() - start
+        if elapsed > TRIAL_SECONDS or (done >= TRIAL_STEPS and elapsed >= TRIAL_LEAST):
             break
     per_step = max(time.perf_counter() - start, 1e-9) / max(done, 1)
     active = sum(len(s.active) for s in state.bodies)
     vertices = sum(len(b.tributary_area) for b in model.bodies)
     writing = _writing(model, state)
-    e = Estimate(stepping=load + per_step * (model.n_steps - warm), writing=writing,
-                 per_step=per_step, points=active * max(1, model.slots), active=active,
-                 vertices=vertices)
+    stepping = load + per_step * (model.n_steps - warm) + _returns(model, state, per_step)
+    e = Estimate(stepping=stepping, writing=writing, per_step=per_step,
+                 points=active * max(1, model.slots), active=active, vertices=vertices)
     if model.cycle_steps:
         e.stepping, e.trial_time, e.trial_covered, e.trial_jumps = _jumping(
             model, e.stepping - load)
         e.stepping += load
     return e
+
+
+def _returns(model, state, per_step):
+    """Seconds the run spends, beyond its steps, leaving the compiled loop
+    for each output and every few thousand steps and checking the state at
+    each output (:func:`meshwear.simulate.advance`): timed on
+    :data:`RETURNS` one-step spans and checks. A validation case writing a
+    history row every step spent twice its steps' and rows' time there (its
+    estimate was half its run)."""
+    from .simulate import PROGRESS_STEPS, check
+
+    if state.step + RETURNS > model.n_steps:
+        return 0.0
+    normals = [b.reference_face_normals for b in model.bodies]
+    start = time.perf_counter()
+    for _ in range(RETURNS):
+        stepper.advance(model, state, state.step + 1)
+        check(model, state, normals)
+    each = max(0.0, (time.perf_counter() - start) / RETURNS - per_step)
+    return each * (len(model.output_steps) + model.n_steps // PROGRESS_STEPS)
 
 
 def _writing(model, state):

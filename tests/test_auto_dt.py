@@ -143,6 +143,30 @@ def test_check_s_estimate_counts_the_outputs_and_caps_jumps_at_resolved(tmp_path
     assert e.trial_covered > 0
 
 
+def test_check_s_estimate_counts_a_return_to_python_per_output(tmp_path, monkeypatch):
+    """The run leaves the compiled loop at each output and every
+    PROGRESS_STEPS steps, and checks the state at each output; ``check``
+    times that on one-step spans: with the span free and the check taking
+    2 ms, 2 ms per output and per PROGRESS_STEPS steps (a validation case
+    writing a row every step had half its run estimated)."""
+    import time
+
+    from meshwear import estimate, simulate
+    from meshwear.simulate import PROGRESS_STEPS
+
+    from meshwear.model import initial_state
+
+    model = build_model(load_scene(write(tmp_path, PIN.format(mode="quasi-static", wear="")),
+                                   [("run.frames", 3), ("run.history", 50)]))
+    state = initial_state(model)
+    monkeypatch.setattr(estimate.stepper, "advance",
+                        lambda m, s, until: setattr(s, "step", until))
+    monkeypatch.setattr(simulate, "check", lambda *a: time.sleep(2e-3))
+    returns = len(model.output_steps) + model.n_steps // PROGRESS_STEPS
+    assert returns >= 50
+    assert estimate._returns(model, state, 0.0) == pytest.approx(2e-3 * returns, rel=0.3)
+
+
 def test_a_jump_trial_stopped_inside_a_cycle_counts_its_steps():
     """The cost of a resolved cycle from ``meshwear check``'s jumping trial:
     a trial that stopped half-way through its third resolved cycle resolved
