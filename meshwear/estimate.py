@@ -105,7 +105,7 @@ def _returns(model, state, per_step):
     for each output and every few thousand steps and checking the state at
     each output (:func:`meshwear.simulate.advance`): timed on
     :data:`RETURNS` one-step spans and checks. A validation case writing a
-    history row every step spent twice its steps' and rows' time there (its
+    history row every step spent as long there as on its steps and rows (its
     estimate was half its run)."""
     from .simulate import PROGRESS_STEPS, check
 

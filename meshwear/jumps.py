@@ -381,8 +381,9 @@ def counter_factors(model, state, measures, results, rates, jump, increments, t,
     contact's) and its barycentric weights on the face it is over at ``t``
     (the end of the cycle). The same contact wears both, so the pressure the
     jump relieves relieves the counter's wear as the body's; a counter vertex
-    the bodies wore but are not over at ``t`` takes the factor of the nearest
-    one they are over, and one they did not wear keeps its rate (factor 1).
+    the bodies wore but are not over at ``t``, or barely wear there
+    (:data:`HELD`), takes the factor of the nearest one they are over and
+    wear, and one they did not wear keeps its rate (factor 1).
 
     A counter vertex also relaxes on its own, faster than the contact where
     its stiffness ``g`` (``stiffness[j]``, per cycle: how much its wear falls
