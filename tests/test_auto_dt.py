@@ -152,9 +152,8 @@ def test_check_s_estimate_counts_a_return_to_python_per_output(tmp_path, monkeyp
     import time
 
     from meshwear import estimate, simulate
-    from meshwear.simulate import PROGRESS_STEPS
-
     from meshwear.model import initial_state
+    from meshwear.simulate import PROGRESS_STEPS
 
     model = build_model(load_scene(write(tmp_path, PIN.format(mode="quasi-static", wear="")),
                                    [("run.frames", 3), ("run.history", 50)]))

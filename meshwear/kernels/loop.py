@@ -17,9 +17,9 @@ body
     ``vertices, pose, area, law, wear_direction, contact_state, tangential,
     normal_force, friction_work, wear_depth, wear_volume, wrench,
     vertex_planes, hint, active, active_wear, cull, distance, load`` (the
-    arrays of :class:`meshwear.model.BodyState` and its model; ``load`` (2, n)
-    adds up each vertex's total normal force and its square over the steps,
-    or is (2, 0)) and
+    arrays of :class:`meshwear.model.BodyState` and its model; ``load`` (5, n)
+    adds up each vertex's total normal force, its square and its vector over
+    the steps, or is (2, 0): :data:`meshwear.jumps.LOAD_ROWS`) and
     ``radius`` (m).
 motion
     ``kind`` and ``params`` (:mod:`meshwear.kernels.rigid`), the path
