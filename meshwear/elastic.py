@@ -409,7 +409,8 @@ def step(model, body, s, t, before, at_rest=False):
     if s.load.shape[1]:
         s.load[0, idx] += F
         s.load[1, idx] += F * F
-        s.load[2:5, idx] += (F[:, None] * normal_world).T
+        if len(s.load) > 2:
+            s.load[2:5, idx] += (F[:, None] * normal_world).T
     if not patch.extra.get("foundation"):
         # the Winkler foundation equivalent to the first contact, for what
         # reasons with one (a cycle jump's re-balance, its wear per unit of

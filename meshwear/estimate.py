@@ -23,6 +23,8 @@ TRIAL_STEPS, TRIAL_SECONDS = 200, 2.0
 #: steps in flight cost a tenth of its steps on the floor, and its
 #: estimate was a third short)
 TRIAL_LEAST = 0.5
+#: the most steps the trial takes between two looks at the clock
+TRIAL_CHUNK = 256
 #: wall time (s) a cycle-jumping run is tried for, and longer, up to
 #: JUMP_TRIAL_LONGEST, until bounds other than growth have set BOUNDED_JUMPS
 #: jumps (what the rest of the run's jumps are extrapolated from)
@@ -40,8 +42,9 @@ FIRST_JUMP_MEASUREMENTS = 3
 class Estimate:
     """Seconds of a run: ``stepping`` (steps, jumps), ``writing`` (frames,
     history rows, the series' set-up), their ``total``; the cost of a step
-    and what it covers; for cycle jumping the trial's length and the steps
-    it covered."""
+    and what it covers; the seconds of loading the kernels (the first step)
+    and of the returns from the compiled loop, both in ``stepping``; for
+    cycle jumping the trial's length and the steps it covered."""
 
     stepping: float
     writing: float
@@ -52,6 +55,8 @@ class Estimate:
     trial_time: float = 0.0
     trial_covered: int = 0
     trial_jumps: int = 0
+    load: float = 0.0
+    returns: float = 0.0
 
     @property
     def total(self):
@@ -74,15 +79,20 @@ def estimate_run(model, state=None):
     start = time.perf_counter()
     stepper.advance(model, state, warm)
     load = time.perf_counter() - start
-    # (leaving the steps the returns to Python are timed on)
-    trial = max(1, model.n_steps - warm - RETURNS)
+    # (leaving the steps the returns to Python are timed on, where the run
+    # has them past its first TRIAL_STEPS)
+    trial = model.n_steps - warm
+    if trial - 2 * RETURNS >= TRIAL_STEPS:
+        trial -= 2 * RETURNS
     done, chunk = 0, 1
     start = time.perf_counter()
     while done < trial:             # in doubling chunks, until TRIAL_SECONDS
         chunk = min(chunk, trial - done)
         stepper.advance(model, state, warm + done + chunk)
         done += chunk
-        chunk *= 2
+        # (no more than TRIAL_CHUNK at a time: steps that turn dear, a
+        # body landing, are not taken by the thousand past the budget)
+        chunk = min(2 * chunk, TRIAL_CHUNK)
         elapsed = time.perf_counter() - start
         if elapsed > TRIAL_SECONDS or (done >= TRIAL_STEPS and elapsed >= TRIAL_LEAST):
             break
@@ -90,9 +100,10 @@ def estimate_run(model, state=None):
     active = sum(len(s.active) for s in state.bodies)
     vertices = sum(len(b.tributary_area) for b in model.bodies)
     writing = _writing(model, state)
-    stepping = load + per_step * (model.n_steps - warm) + _returns(model, state, per_step)
-    e = Estimate(stepping=stepping, writing=writing, per_step=per_step,
-                 points=active * max(1, model.slots), active=active, vertices=vertices)
+    returns = _returns(model, state)
+    e = Estimate(stepping=load + per_step * (model.n_steps - warm) + returns, writing=writing,
+                 per_step=per_step, points=active * max(1, model.slots), active=active,
+                 vertices=vertices, load=load, returns=returns)
     if model.cycle_steps:
         e.stepping, e.trial_time, e.trial_covered, e.trial_jumps = _jumping(
             model, e.stepping - load)
@@ -100,23 +111,28 @@ def estimate_run(model, state=None):
     return e
 
 
-def _returns(model, state, per_step):
+def _returns(model, state):
     """Seconds the run spends, beyond its steps, leaving the compiled loop
     for each output and every few thousand steps and checking the state at
-    each output (:func:`meshwear.simulate.advance`): timed on
-    :data:`RETURNS` one-step spans and checks. A validation case writing a
-    history row every step spent as long there as on its steps and rows (its
-    estimate was half its run)."""
+    each output (:func:`meshwear.simulate.advance`): :data:`RETURNS`
+    one-step spans and checks timed against as many steps in one span just
+    before them (not against the trial's mean step, which a run whose steps
+    turn dearer, a body landing, would have booked as returns). A
+    validation case writing a history row every step spent as long there
+    as on its steps and rows (its estimate was half its run)."""
     from .simulate import PROGRESS_STEPS, check
 
-    if state.step + RETURNS > model.n_steps:
+    if state.step + 2 * RETURNS > model.n_steps:
         return 0.0
     normals = [b.reference_face_normals for b in model.bodies]
+    start = time.perf_counter()
+    stepper.advance(model, state, state.step + RETURNS)
+    spanned = time.perf_counter() - start
     start = time.perf_counter()
     for _ in range(RETURNS):
         stepper.advance(model, state, state.step + 1)
         check(model, state, normals)
-    each = max(0.0, (time.perf_counter() - start) / RETURNS - per_step)
+    each = max(0.0, (time.perf_counter() - start - spanned) / RETURNS)
     return each * (len(model.output_steps) + model.n_steps // PROGRESS_STEPS)
 
 

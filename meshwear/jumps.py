@@ -196,18 +196,20 @@ def measure(model, body, s, rate, start=None, window=1):
         facing = np.where(np.any(normal != 0.0, axis=1)[:, None], normal,
                           -(body.area_vectors[index, 0:3] @ quaternion_matrix(s.pose[3:7]).T)
                           / np.maximum(body.area_vectors[index, 3:4], 1e-300))
-        # and one touched in the cycle but not at its end, along the mean
-        # direction of the forces that pressed it then: where it will be
-        # pressed again, its end place being anywhere (a flank of a turning
-        # gear, half a turn from its mate, faced the way it is turned to:
-        # the move along the line of centres took off its penetration as
-        # much as that direction's share of the axis, different on each
-        # flank, and after 10^5 revolutions the two flanks of a tooth were
-        # worn up to 12 % of the deepest apart)
-        pushed = s.load[2:5, index].T if len(s.load) >= LOAD_ROWS else np.zeros((len(index), 3))
-        size = np.linalg.norm(pushed, axis=1)
-        along = touched & (size > 0.0)
-        facing[along] = pushed[along] / size[along, None]
+        # and one touched in the cycle but not at its end, along the
+        # force-weighted mean of the normals that pressed it then: where it
+        # will be pressed again, its end place being anywhere (a flank of a
+        # turning gear, half a turn from its mate, faced the way it is
+        # turned to: the move along the line of centres took off its
+        # penetration as much as that direction's share of the axis,
+        # different on each flank, and after 10^5 revolutions the two flanks
+        # of a tooth were worn up to 12 % of the deepest apart). A unit
+        # vector where all pressed one way, shorter where they disagree (a
+        # roller pressed from both sides: the move takes off as much as it
+        # adds)
+        if len(s.load) >= LOAD_ROWS:
+            along = touched & (force > 0.0)
+            facing[along] = s.load[2:5, index[along]].T / force[along, None]
     if guided:
         beta = facing @ motion.axis
         carried = (motion.carried if isinstance(motion, BalancedMotion)

@@ -123,13 +123,15 @@ def touch(model, body, s, t):
         force = s.normal_force[:, a].sum(axis=0)
         s.load[0, a] += force
         s.load[1, a] += force * force
-        # each slot's force along its normal (planes first, as the kernel's
-        # slots), summed over the slots before it is added, as the kernel does
-        normals = [p[1] for p in model.planes] + [vp[a, 1] for vp in s.vertex_planes]
-        pushed = np.zeros((3, len(a)))
-        for slot, normal in enumerate(normals):
-            pushed += (s.normal_force[slot, a][:, None] * normal).T
-        s.load[2:5, a] += pushed
+        if len(s.load) > 2:
+            # each slot's force along its normal (planes first, as the
+            # kernel's slots), summed over the slots before it is added, as
+            # the kernel does
+            normals = [p[1] for p in model.planes] + [vp[a, 1] for vp in s.vertex_planes]
+            pushed = np.zeros((3, len(a)))
+            for slot, normal in enumerate(normals):
+                pushed += (s.normal_force[slot, a][:, None] * normal).T
+            s.load[2:5, a] += pushed
     if model.worn_counters:
         too_deep = wear_counters(model, body, s, t)
         if too_deep is not None:

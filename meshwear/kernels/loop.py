@@ -102,6 +102,7 @@ def _touch(body, plane_array):
                        wear_depth, wear_volume, wrench)
     if load.shape[1]:
         n_planes = plane_array.shape[0]
+        vectors = load.shape[0] > 2
         for k in range(active.shape[0]):
             i = active[k]
             total = fx = fy = fz = 0.0
@@ -116,9 +117,10 @@ def _touch(body, plane_array):
                     fz += f * nz
             load[0, i] += total
             load[1, i] += total * total
-            load[2, i] += fx
-            load[3, i] += fy
-            load[4, i] += fz
+            if vectors:
+                load[2, i] += fx
+                load[3, i] += fy
+                load[4, i] += fz
 
 
 @njit(cache=True)
