@@ -115,9 +115,10 @@ def _returns(model, state):
     """Seconds the run spends, beyond its steps, leaving the compiled loop
     for each output and every few thousand steps and checking the state at
     each output (:func:`meshwear.simulate.advance`): :data:`RETURNS`
-    one-step spans and checks timed against as many steps in one span just
-    before them (not against the trial's mean step, which a run whose steps
-    turn dearer, a body landing, would have booked as returns). A
+    one-step spans timed against as many steps in one span just before them
+    (not against the trial's mean step, which a run whose steps turn
+    dearer, a body landing, would have booked as returns), and as many
+    checks. A
     validation case writing a history row every step spent as long there
     as on its steps and rows (its estimate was half its run)."""
     from .simulate import PROGRESS_STEPS, check
@@ -131,9 +132,13 @@ def _returns(model, state):
     start = time.perf_counter()
     for _ in range(RETURNS):
         stepper.advance(model, state, state.step + 1)
-        check(model, state, normals)
     each = max(0.0, (time.perf_counter() - start - spanned) / RETURNS)
-    return each * (len(model.output_steps) + model.n_steps // PROGRESS_STEPS)
+    start = time.perf_counter()
+    for _ in range(RETURNS):
+        check(model, state, normals)
+    checked = (time.perf_counter() - start) / RETURNS
+    outputs = len(model.output_steps)
+    return each * (outputs + model.n_steps // PROGRESS_STEPS) + checked * outputs
 
 
 def _writing(model, state):
