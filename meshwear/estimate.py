@@ -29,7 +29,7 @@ TRIAL_CHUNK = 256
 #: JUMP_TRIAL_LONGEST, until bounds other than growth have set BOUNDED_JUMPS
 #: jumps (what the rest of the run's jumps are extrapolated from)
 JUMP_TRIAL, JUMP_TRIAL_LONGEST, BOUNDED_JUMPS = 3.0, 10.0, 8
-#: one-step spans of the compiled loop timed, each with the state's check, for
+#: one-step spans of the compiled loop, and checks of the state, timed for
 #: what the run's returns to Python cost beyond their steps (:func:`_returns`)
 RETURNS = 20
 #: measurements the controller takes before its noise bounds let a first
@@ -118,9 +118,8 @@ def _returns(model, state):
     one-step spans timed against as many steps in one span just before them
     (not against the trial's mean step, which a run whose steps turn
     dearer, a body landing, would have booked as returns), and as many
-    checks. A
-    validation case writing a history row every step spent as long there
-    as on its steps and rows (its estimate was half its run)."""
+    checks. A validation case writing a history row every step spent as
+    long there as on its steps and rows (its estimate was half its run)."""
     from .simulate import PROGRESS_STEPS, check
 
     if state.step + 2 * RETURNS > model.n_steps:

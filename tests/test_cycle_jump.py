@@ -296,18 +296,24 @@ center = [0.005, 0.0, -0.01]
 """
 
 
+def _resolved_and_jumped(path, text):
+    """The model of scene ``text`` (written to ``path``) and its final
+    states resolved at every cycle and jumped by the controller."""
+    path.write_text(text)
+    runs = {}
+    for name, forced in (("resolved", 0), ("jumped", None)):
+        model = build_model(load_scene(path))
+        runs[name] = run(model, initial_state(model), forced_jump=forced)
+    return model, runs
+
+
 def test_a_track_touched_once_a_turn_jumps_as_resolved(tmp_path, measured):
     """Intermittent contact (docs/model.md, "Implicit jumps"): each track
     vertex's wear per unit of its penetration *while in contact*, its relief
     and the body's sinking as the whole track wears carry the jumps. Against
     the same run resolved at the same step (the sampling of each pass is
     locked to the turn), within the tolerance, in under half the cycles."""
-    path = tmp_path / "disc_on_ball.toml"
-    path.write_text(DISC_ON_A_BALL)
-    runs = {}
-    for name, forced in (("resolved", 0), ("jumped", None)):
-        model = build_model(load_scene(path))
-        runs[name] = run(model, initial_state(model), forced_jump=forced)
+    model, runs = _resolved_and_jumped(tmp_path / "disc_on_ball.toml", DISC_ON_A_BALL)
     w_ref = runs["resolved"].bodies[0].wear_depth
     w = runs["jumped"].bodies[0].wear_depth
     assert runs["resolved"].jump.resolved_steps == model.n_steps
@@ -325,24 +331,9 @@ def test_a_track_touched_once_a_turn_jumps_as_resolved(tmp_path, measured):
 #: a wall across its axis, as a pinion is pressed into its wheel along the
 #: line of centres: each rim vertex touches the wall for a few steps of the
 #: 157 of a turn, at the end of a cycle facing any way round. Soft contact
-#: (K = 1e10 N/m³, 0.2 mm approach), 30 turns.
-DISC_ON_A_WALL = """format = 1
-[run]
-mode = "quasi-static"
-duration = 18.84955592153876
-dt = 4e-3
-frames = 0
-history = 2
-gravity = [0.0, 0.0, 0.0]
-[contact]
-stiffness_per_area = 1e10
-friction = 0.3
-[wear]
-law = "archard"
-coefficient = 2e-10
-acceleration = "cycle_jump"
-tolerance = 0.01
-[[body]]
+#: (K = 1e10 N/m³, 0.2 mm approach), 30 turns: the ball's run, contact and
+#: wear.
+DISC_ON_A_WALL = DISC_ON_A_BALL[:DISC_ON_A_BALL.index("[[body]]")] + """[[body]]
 name = "disc"
 shape = { type = "cylinder", radius = 0.008, height = 0.002, sections = 96 }
 density = 7850.0
@@ -368,12 +359,7 @@ def test_a_rim_pressed_across_its_turning_axis_jumps_as_resolved(tmp_path, measu
     vertex faces away from it, and taken so its jumps wore the rim 9 % of
     its depth unevenly and 5 % off the resolved run. Within the tolerance
     of the run resolved at the same step, the rim as even as there."""
-    path = tmp_path / "disc_on_wall.toml"
-    path.write_text(DISC_ON_A_WALL)
-    runs = {}
-    for name, forced in (("resolved", 0), ("jumped", None)):
-        model = build_model(load_scene(path))
-        runs[name] = run(model, initial_state(model), forced_jump=forced)
+    model, runs = _resolved_and_jumped(tmp_path / "disc_on_wall.toml", DISC_ON_A_WALL)
     w_ref = runs["resolved"].bodies[0].wear_depth
     w = runs["jumped"].bodies[0].wear_depth
     assert runs["jumped"].jump.resolved_steps < 0.5 * model.n_steps
