@@ -166,6 +166,27 @@ def test_check_s_estimate_counts_a_return_to_python_per_output(tmp_path, monkeyp
                                                             rel=0.3)
 
 
+def test_check_writes_no_trial_frame_for_a_run_without_frames(tmp_path, monkeypatch):
+    """A run with ``frames = 0`` writes no frame: the writing's trial writes
+    none either (one frame of a 52 000-vertex ball, 0.13 s, made a 0.3 s
+    validation case's estimate half as long again); history rows are
+    written and timed as before."""
+    from meshwear import estimate
+    from meshwear.model import initial_state
+    from meshwear.output.recorder import RunRecorder
+
+    written = []
+    monkeypatch.setattr(RunRecorder, "on_frame", lambda *a: written.append("frame"))
+    monkeypatch.setattr(RunRecorder, "on_sample", lambda *a: written.append("row"))
+    for frames, rows in ((0, 5), (3, 2)):
+        model = build_model(load_scene(write(tmp_path, PIN.format(mode="quasi-static", wear="")),
+                                       [("run.frames", frames), ("run.history", rows)]))
+        assert len(model.frame_steps) == frames and len(model.sample_steps) == rows
+        written.clear()
+        estimate._writing(model, initial_state(model))
+        assert written.count("frame") == min(frames, 2) and written.count("row") == min(rows, 2)
+
+
 def test_a_jump_trial_stopped_inside_a_cycle_counts_its_steps():
     """The cost of a resolved cycle from ``meshwear check``'s jumping trial:
     a trial that stopped half-way through its third resolved cycle resolved
