@@ -681,16 +681,30 @@ def _faces_to_refine(scene, body, vertices, faces, surface_set):
     """Faces ``resolution`` refines: all of a free body (it may land on any
     face); of a guided, prescribed or fixed one (which only translates) the
     faces that face a surface within :data:`REFINE_REACH` of its size at the
-    start (its path's displacement included); all of one that turns."""
+    start (its path's displacement included); all of one that turns.
+
+    With ``resolution_reach`` given, the faces within it, chosen anew at
+    each pass of the refinement (:func:`meshwear.remesh.refine`) on the
+    part's true surface (a primitive's vertices put on it, each face's sag
+    allowed for): the faces of a coarse sphere are a millimetre wide, and
+    taken whole a 10 mm ball with a 20 µm reach had 200 000 vertices refined
+    to 7 µm over 9 mm² where its cap within reach is 1.3 mm²."""
     if body.motion in ("free", "mechanism") or (body.path is not None
                                                 and body.path.rotation is not None):
         return None
     R = np.array(rotation_entries(np.asarray(body.orientation, float))).reshape(3, 3)
-    points = vertices @ R.T + np.asarray(body.position, float) + Path(body.path).displacement(0.0)
+    offset = np.asarray(body.position, float) + Path(body.path).displacement(0.0)
     reach = body.resolution_reach
     if reach is None:
         reach = REFINE_REACH * float(np.linalg.norm(np.ptp(vertices, axis=0)))
-    return surfaces.contact_faces(points, faces, surface_set, reach)
+        return surfaces.contact_faces(vertices @ R.T + offset, faces, surface_set, reach)
+
+    def select(vertices, faces):
+        true = geometry.snap_to_primitive(body.shape, vertices, faces)
+        sag = geometry.facet_sag(body.shape, true, faces)
+        return surfaces.contact_faces(true @ R.T + offset, faces, surface_set, reach, sag)
+
+    return select
 
 
 #: an initial penetration deeper than this fraction of the body's smallest
