@@ -699,11 +699,16 @@ def _faces_to_refine(scene, body, vertices, faces, surface_set):
         reach = REFINE_REACH * float(np.linalg.norm(np.ptp(vertices, axis=0)))
         return surfaces.contact_faces(vertices @ R.T + offset, faces, surface_set, reach)
 
-    def select(vertices, faces):
+    def select(vertices, faces, every=False):
         true = geometry.snap_to_primitive(body.shape, vertices, faces)
-        sag = geometry.facet_sag(body.shape, true, faces)
-        return surfaces.contact_faces(true @ R.T + offset, faces, surface_set, reach, sag)
+        sag = None if every else geometry.facet_sag(body.shape, true, faces)
+        return surfaces.contact_faces(true @ R.T + offset, faces, surface_set, reach, sag,
+                                      every)
 
+    # (the faces wholly within reach are surely refined: too fine a
+    # resolution is refused before the first pass, not after the passes
+    # have filled the memory)
+    select.surely = lambda vertices, faces: select(vertices, faces, every=True)
     return select
 
 

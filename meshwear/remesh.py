@@ -80,7 +80,9 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=None, return_m
         unselected faces are split only where needed to stay conforming. A
         callable ``face_mask(vertices, faces)`` selects anew after each pass
         (a big face of which only a part is to be refined: its children
-        away from that part are left).
+        away from that part are left); its attribute ``surely(vertices,
+        faces)``, if it has one, gives the faces it refines whatever the
+        passes (their area is checked against ``max_faces`` at once).
     max_faces : int, optional
         Refuse (MeshError) rather than build a larger mesh: at once when the
         selected area alone needs more faces (a triangle with edges <=
@@ -104,8 +106,12 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=None, return_m
             else np.asarray(face_mask, bool).copy())
     if mask.shape != (len(F),):
         raise ValueError(f"face_mask has shape {mask.shape}, expected ({len(F)},)")
-    # (a selection made anew each pass may keep far less than its first one)
-    area = 0.0 if select is not None else 0.5 * float(_doubled_areas(V, F[mask]).sum())
+    # (a selection made anew each pass may keep far less than its first one:
+    # only the faces it says it surely refines, if it says, are counted)
+    surely = getattr(select, "surely", None)
+    counted = (mask if select is None else surely(V, F) if surely is not None
+               else np.zeros(len(F), bool))
+    area = 0.5 * float(_doubled_areas(V, F[counted]).sum())
     cell = _LARGEST_UNIT_TRIANGLE * resolution**2     # 0.0 for a subnormal resolution
     least = area / cell if cell > 0.0 else float("inf")
     why = "the limit asked"

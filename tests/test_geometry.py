@@ -400,6 +400,14 @@ def test_a_ball_is_refined_within_its_resolution_reach_not_over_its_coarse_faces
     assert np.all(refined[height[f].min(axis=1) <= 2e-5])
     assert height[f[refined]].max() <= 2e-5 + 2 * 2e-5
     assert np.abs(np.linalg.norm(v - body.origin, axis=1) - 0.01).max() <= 1e-9 * 0.01
+    # too fine a resolution is refused before the passes, from the faces
+    # wholly within the reach (chosen anew at each pass, the selection's
+    # size is not known before: 17 passes and 4 GB went by before the
+    # refusal)
+    path.write_text(BALL_ON_A_PLANE.replace("resolution = 2e-5", "resolution = 2e-6")
+                    .replace("resolution_reach = 2e-5", "resolution_reach = 1e-3"))
+    with pytest.raises(Exception, match="needs at least"):
+        build_model(load_scene(path))
 
 
 def test_refined_primitives_put_their_vertices_on_the_exact_surface():

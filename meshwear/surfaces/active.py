@@ -344,14 +344,15 @@ def initial_planes(surface_set, body, pose, reach):
     return out, distance
 
 
-def contact_faces(points, faces, surface_set, reach, sag=None):
+def contact_faces(points, faces, surface_set, reach, sag=None, every=False):
     """(m,) bool: the faces of a body (``points`` its vertices in the world at
     the start) that can come into contact: they face a plane or the nearest
     point of another surface, and a vertex of theirs lies within ``reach`` (m)
     of it, or within ``reach`` plus the face's ``sag`` ((m,) m, None: 0),
     how far the part's true surface over the face may bulge out of it (a
-    facet of a sphere). For refining a CAD part where it can touch, not
-    everywhere."""
+    facet of a sphere); with ``every``, all three of its vertices (faces
+    surely refined: a lower bound of the refinement's size). For refining a
+    CAD part where it can touch, not everywhere."""
     from .. import geometry
 
     normals = geometry.face_normals(points, faces)
@@ -359,17 +360,21 @@ def contact_faces(points, faces, surface_set, reach, sag=None):
     mask = np.zeros(len(faces), dtype=bool)
     for p in surface_set.planes:
         gap = (points - p[0]) @ p[1]
-        mask |= (normals @ p[1] < -FACING) & (gap[faces].min(axis=1) <= allowed)
+        corners = gap[faces].max(axis=1) if every else gap[faces].min(axis=1)
+        mask |= (normals @ p[1] < -FACING) & (corners <= allowed)
     identity = np.zeros(13)
     identity[3] = 1.0
     points = np.ascontiguousarray(points)
     for surface in surface_set.per_vertex:
         vp, d = surface.planes_at(points, identity, 0.0, float(np.max(allowed, initial=reach)))
         # a face faces the surface where one of its vertices near it does
+        # (all of them, with every)
+        near = np.ones(len(faces), dtype=bool) if every else np.zeros(len(faces), dtype=bool)
         for corner in range(3):
             v = faces[:, corner]
             facing = np.einsum("ij,ij->i", normals, vp[v, 1]) < -FACING
-            mask |= facing & (d[v] <= allowed)
+            near = near & facing & (d[v] <= allowed) if every else near | facing & (d[v] <= allowed)
+        mask |= near
     return mask
 
 
