@@ -82,6 +82,10 @@ def save(path, model, state, wall_time):
             arrays[f"body{k}_{name}"] = getattr(s, name)
         arrays[f"body{k}_active"] = s.active
         arrays[f"body{k}_active_wear"] = s.active_wear
+        # (the rows the pairs' log last needed: a resumed run sizes its log,
+        # and whether it held every pair, as the whole run does)
+        arrays[f"body{k}_log_count"] = s.log_count
+        arrays[f"body{k}_log_rows"] = np.array([len(s.log_index)])
     own = model.dynamics.get_state()
     if own is not None:
         # a mechanism's (MuJoCo's whole integration state): bit for bit on resuming
@@ -188,6 +192,10 @@ def load(path, model, state):
                 getattr(s, name)[...] = data[f"body{k}_{name}"]
             s.active = data[f"body{k}_active"].astype(np.int64)
             s.active_wear = data[f"body{k}_active_wear"].copy()
+            if f"body{k}_log_count" in data:
+                s.log_count[...] = data[f"body{k}_log_count"]
+                rows = int(data[f"body{k}_log_rows"][0])
+                s.log_index, s.log_value = np.zeros((rows, 3), np.int64), np.zeros(rows)
         # in place: the worn surfaces query and draw these very arrays
         for m, part in enumerate(state.parts):
             if part is not None:

@@ -210,6 +210,15 @@ class BodyState:
     #: deepest vertex in contact has to be measured again against its
     #: ``depth_limit`` (docs/model.md, "Impacts"); 0: at the next step
     impact_room: np.ndarray = field(default_factory=lambda: np.zeros(1))
+    #: the pairs' shares of the worn counter-surfaces' vertices, logged
+    #: over a measured cycle for implicit jumps (:func:`meshwear.jumps.pair_log`):
+    #: rows (surface, vertex, counter vertex) and the pair's normal force on
+    #: the counter vertex (N), the rows used and whether to log (0 rows: not kept)
+    log_index: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.int64))
+    log_value: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    log_count: np.ndarray = field(default_factory=lambda: np.zeros(2, np.int64))
+    #: the step from which the log holds every pair (-1: none)
+    log_from: int = -1
     #: the half-space solve kept from step to step (:class:`meshwear.elastic.Patch`;
     #: a cache, not saved in checkpoints), or None
     elastic: object = None
@@ -816,7 +825,7 @@ def wear_counters(model, body, s, t, pairs=None):
             worst = wear_counter(s.vertices, s.pose, s.active, body.area_vectors, model.law,
                                  state, force,
                                  s.vertex_planes[m], s.hint[m], rotation, frame,
-                                 surface.part_tuple())
+                                 surface.part_tuple(), m, s.log_index, s.log_value, s.log_count)
             if worst >= 0:
                 return surface, worst
     return None

@@ -12,7 +12,7 @@ def body_arrays(model, body, s):
             s.contact_state, s.tangential, s.normal_force, s.friction_work, s.wear_depth,
             s.wear_volume, s.wrench, s.vertex_planes, s.hint, s.active, s.active_wear, s.cull,
             s.cull_scratch.distance, s.load, float(body.radius), float(body.depth_limit),
-            s.impact_room)
+            s.impact_room, s.log_index, s.log_value, s.log_count)
 
 
 def motion_arrays(model, body, s):

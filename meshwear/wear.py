@@ -246,6 +246,9 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
             s.load[:] = 0.0
         for _, part in parts:
             part.stiffness[:] = 0.0      # each counter vertex's, summed over the measurement
+        if implicit and parts:
+            for s in state.bodies:       # the pairs that wear the counters, over the measurement
+                jumps.start_log(s, start, js.window * n_c)
         # a measurement averages the wear of ``window`` consecutive cycles
         # (one, unless single cycles disagree): the last one is recorded for
         # the outputs a jump after it fills
@@ -291,11 +294,13 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                 js.part_past[k] = (js.part_past[k] + [(middle, depth, rate, stiffness[j])]
                                    )[-HISTORY:]
             js.part_noise[k] = _counter_noise(js, k, settled[j], middle)
-        if parts:
+        logs = None
+        if parts and implicit:
+            logs = [jumps.pair_log(s, start) for s in state.bodies]
             # (before the relaxation: the counter-part's wear under each
             # body vertex relaxes its errors too, gamma_i)
-            for s, m in zip(state.bodies, measures):
-                jumps.counter_relief(model, s, m, settled, state.time)
+            for s, m, log in zip(state.bodies, measures, logs):
+                jumps.counter_relief(model, s, m, settled, state.time, log)
         js.relax = _relaxation(measures)
         _relax_resolved(js, measures, part_rates, window)
         js.noisy = False

@@ -458,13 +458,14 @@ def sphere_planes(body_vertices, pose, active, rotation, frame, geometry, out, d
 
 
 def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, normal_force,
-                 planes, hint, rotation, frame, part):
+                 planes, hint, rotation, frame, part, surface=0, log=None):
     """Same contract as :func:`meshwear.kernels.counter_wear.wear_counter`,
     array at a time (the pairs' energy and slip from their velocities, the
     law's twin, the closest-point weights of :func:`closest_points`); the
     face frames are all recomputed. Returns the vertices that sank more than
     half their spacing since they last moved (the kernel returns the first
-    of them)."""
+    of them). ``log``: (index, value, count) as the kernel's log (logged
+    while ``count[1]`` is 1)."""
     (counter_law, faces, reference, normals, tributary, spacing, _, _, vertices, frames, depth,
      volume, work, added, _, limit, _, _, stiffness, _) = part
     code, k = int(counter_law[0]), counter_law[1]
@@ -490,6 +491,17 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
     q = (foot - frame[0]) @ rotation
     corners = faces[hint[i]]
     _, weights = closest_points(vertices[corners], q)
+    if log is not None and log[2][1] == 1:
+        index, value, count = log
+        wearing = (dv > 0.0) | (energy > 0.0)
+        for p in np.flatnonzero(wearing):
+            for c in range(3):
+                if weights[p, c] > 0.0:
+                    row, j = count[0], corners[p, c]
+                    if row < len(index):
+                        index[row] = surface, i[p], j
+                        value[row] = weights[p, c] * load[p]
+                    count[0] = row + 1
     before = depth.copy()
     for c in range(3):
         np.add.at(work, corners[:, c], weights[:, c] * energy)

@@ -104,10 +104,29 @@ def test_kernel_matches_its_numpy_twin(tmp_path):
     # the same step taken over and over: vertices lag, then move once their
     # lag reaches LAG_FRACTION of their pairs' penetration
     lagged = moved = False
-    for _ in range(400):
-        assert wear_counter(*args, disc.part_tuple()) == -1
-        assert len(reference.wear_counter(*args, twin_tuple)) == 0
+    # the pairs' log (implicit jumps): each pair's share of each counter vertex
+    rows = 3 * len(s.active)
+    log = (np.zeros((rows, 3), np.int64), np.zeros(rows), np.array([0, 1]))
+    twin_log = (np.zeros((rows, 3), np.int64), np.zeros(rows), np.array([0, 1]))
+    for step in range(400):
+        log[2][0] = twin_log[2][0] = 0
+        assert wear_counter(*args, disc.part_tuple(), 0, *log) == -1
+        assert len(reference.wear_counter(*args, twin_tuple, 0, twin_log)) == 0
         same()
+        if step == 0:
+            count = log[2][0]
+            assert count == twin_log[2][0] > 100
+            np.testing.assert_array_equal(log[0][:count], twin_log[0][:count])
+            np.testing.assert_allclose(log[1][:count], twin_log[1][:count], rtol=1e-12,
+                                       atol=1e-12 * np.abs(twin_log[1][:count]).max())
+            # each pair's rows share its normal force among the corners of
+            # the face under it: they add up to the force of every vertex
+            # over a face
+            i = log[0][:count, 1]
+            over = np.unique(i)
+            np.testing.assert_allclose(np.bincount(i, log[1][:count])[over],
+                                       s.normal_force[0, over], rtol=1e-12)
+            assert (s.normal_force[0, over] > 0.0).all()
         lagging = part.added > 0.0
         lagged |= lagging.any()
         at_depth = np.all(part.vertices == disc.reference_vertices

@@ -194,13 +194,20 @@ _pairs_parallel = njit(cache=True, parallel=True)(_named_copy(_pairs, "_pairs_pa
 
 @njit(cache=True)
 def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_force, planes,
-                 hint, rotation, frame, part):
+                 hint, rotation, frame, part, surface, log_index, log_value, log_count):
     """Wear the counter-part ``part`` by every pair of the step just taken
     (``contact_state``, ``normal_force``: this surface's rows), and move the
     vertices whose lag reached their limit. Returns -1, or the first counter
     vertex that sank deeper than :data:`SPACING_FRACTION` of its spacing
     since it last moved (the step is done all the same: the caller stops the
-    run)."""
+    run).
+
+    While ``log_count[1]`` is 1 each pair's share of each counter vertex is
+    logged, for the jumps (:func:`meshwear.jumps.pair_log`): row
+    ``log_count[0]`` of ``log_index`` (per-vertex surface ``surface``, the
+    body vertex, the counter vertex) and of ``log_value`` (the pair's
+    normal force times its weight on the counter vertex, N);
+    ``log_count[0]`` counts on past the rows (then the log is incomplete)."""
     (counter_law, faces, reference, normals, tributary, spacing, starts, items, vertices, frames,
      depth, volume, work, added, touched, limit, due, lagging, stiffness, place) = part
     keep_stiffness = stiffness.shape[0] > 0
@@ -216,6 +223,8 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
     count = lagging[0]
     moving = 0
     deep = False
+    logging = log_count[1] == 1
+    rows = log_index.shape[0]
     for slot in range(m):
         face = at[slot]
         if face < 0:
@@ -227,6 +236,14 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
             share = weights[corner]
             if share <= 0.0:
                 continue
+            if logging:
+                row = log_count[0]
+                if row < rows:
+                    log_index[row, 0] = surface
+                    log_index[row, 1] = active[slot]
+                    log_index[row, 2] = j
+                    log_value[row] = share * normal_force[active[slot]]
+                log_count[0] = row + 1
             work[j] += share * energy
             if dv > 0.0:
                 volume[j] += share * dv

@@ -90,7 +90,7 @@ def _touch(body, plane_array):
     (:data:`meshwear.jumps.LOAD_ROWS`)."""
     (vertices, pose, area, law, wear_direction, contact_state, tangential, normal_force,
      friction_work, wear_depth, wear_volume, wrench, vertex_planes, hint, active, active_wear,
-     cull, distance, load, radius, depth_limit, impact_room) = body
+     cull, distance, load, radius, depth_limit, impact_room, _, _, _) = body
     slots = plane_array.shape[0] + vertex_planes.shape[0]
     if PARALLEL and active.shape[0] * slots >= PARALLEL_THRESHOLD:
         contact_parallel(vertices, pose, plane_array, vertex_planes, active, area, law,
@@ -188,7 +188,7 @@ def _wear_parts(body, surfaces, law, n_planes, t, buffer, rotation, frame, repor
         surface_frame(surface[2], surface[3], t, surface[4], buffer, rotation, frame)
         worst = wear_counter(vertices, pose, active, area, law, contact_state[n_planes + m],
                              normal_force[n_planes + m], vertex_planes[m], hint[m], rotation,
-                             frame, part)
+                             frame, part, m, body[22], body[23], body[24])
         if worst >= 0:
             report[0], report[1] = m, worst
             return False
