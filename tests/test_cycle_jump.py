@@ -503,6 +503,46 @@ def test_the_implicit_step_kernel_matches_its_numpy_twin(monkeypatch):
     assert compared >= 64
 
 
+def test_a_jump_keeps_its_volume_along_the_change_of_every_alpha_alike():
+    """A load-carrying body's jump reaches its measured volume by taking
+    every vertex's wear per unit penetration (1 + lambda) times larger with
+    the balance held (docs/model.md, "Long durations", bound "volume"):
+    _volume_direction's first-order change of each vertex's wear and of the
+    move is the backward-Euler step's own (central differences of
+    single_step over alpha). Where J alpha is small it is each vertex's wear
+    scaled alike; where it is large, a sink of the body: every vertex
+    pressed along the axis wears the same more, keeping the shape the jump
+    wore (scaling every vertex's wear there left the block-on-ring scar's
+    edge 4.2 % of its depth off the ring's arc)."""
+    from meshwear.jumps import BodyJump, single_step
+    from meshwear.wear import _volume_direction
+
+    p = np.array([1.0, 1.2, 0.8, 1.1]) * 1e-6
+    c = np.full(4, 1e6)
+
+    def measure(alpha):
+        return BodyJump(index=np.arange(4), alpha=alpha, depth=p.copy(), mean=p.copy(),
+                        now=p.copy(), normal=np.tile([0.0, 0.0, 1.0], (4, 1)), stiffness=c,
+                        member=np.ones(4, bool), touched=np.zeros(4, bool), beta=np.ones(4),
+                        load=float(c @ p), guided=True, gamma=np.array([0.0, 5e-4, 0.0, 0.0]))
+
+    alpha = np.array([1e-3, 2e-3, 5e-4, 1e-3])
+    eps = 1e-6
+    for jump in (10.0, 1e5):
+        wear, z = single_step(measure(alpha), jump)
+        grow, sink = _volume_direction(measure(alpha), wear, jump)
+        up, z_up = single_step(measure(alpha * (1.0 + eps)), jump)
+        down, z_down = single_step(measure(alpha * (1.0 - eps)), jump)
+        np.testing.assert_allclose(grow, (up - down) / (2.0 * eps), rtol=1e-5)
+        assert sink == pytest.approx((z_up - z_down) / (2.0 * eps), rel=1e-5)
+        if jump == 10.0:                 # J alpha <= 0.02: a scale
+            np.testing.assert_allclose(grow, wear, rtol=0.03)
+        else:                            # J alpha >= 50: a sink, alike on every vertex
+            own = grow[[0, 2, 3]]        # (vertex 1's counter-part takes a share)
+            assert np.ptp(own) < 1e-3 * own.mean()
+            assert -sink == pytest.approx(own.mean(), rel=0.02)
+
+
 def test_a_vertex_touched_but_not_at_the_cycle_s_end_wears_at_most_twice_its_measured_rate():
     """A guided body moving along its axis over a jump presses the vertices
     in the balance deeper; one touched in the cycle but not at its end may
