@@ -558,27 +558,25 @@ def _keep_volume(bodies, measures, rates, states, before, results, jump, window,
     out = []
     for k, (body, m, r, s, b, (wear, move, error)) in enumerate(
             zip(bodies, measures, rates, states, before, results)):
-        # the volume the jump plans (:func:`_jump`): each vertex's of the
-        # cycle scaled like its wear, and the vertices it brings into contact
-        cycle = (s.wear_volume - b[2]) / window
-        wearing = r > 0.0
-        planned = float((wear[wearing] / r[wearing]) @ cycle[wearing])
-        fresh = ~wearing & (wear > 0.0)
-        if fresh.any():
-            normal = np.zeros((len(r), 3))
-            normal[m.index] = m.normal
-            planned += float(wear[fresh] @ _fresh_area(body, s, fresh, normal))
         target = jump * rate[-1, k] + 0.5 * jump * jump * slope[k]
         if m.guided and m.load != 0.0 and target > 0.0:
+            # the volume the jump plans (:func:`_jump`), per unit of each
+            # vertex's wear: its volume of the cycle over its wear then, or,
+            # brought into contact by the jump, its contact area
+            area = np.zeros(len(r))
+            wearing = r > 0.0
+            area[wearing] = (s.wear_volume[wearing] - b[2][wearing]) / window / r[wearing]
+            fresh = ~wearing & (wear > 0.0)
+            if fresh.any():
+                normal = np.zeros((len(r), 3))
+                normal[m.index] = m.normal
+                area[fresh] = _fresh_area(body, s, fresh, normal)
+            planned = float(wear @ area)
             if abs(planned - target) > KEEP * target and not forced:
                 return None
             # every vertex's wear per unit penetration taken a little larger
             # (or smaller) until the volume is the measurements'
             # (:func:`_volume_direction`)
-            area = np.zeros(len(r))
-            area[wearing] = cycle[wearing] / r[wearing]
-            if fresh.any():
-                area[fresh] = _fresh_area(body, s, fresh, normal)
             grow, sink = _volume_direction(m, wear, jump)
             per_unit = float(grow @ area)
             if per_unit > 0.0:
