@@ -14,68 +14,9 @@ import os as _os
 __version__ = "0.1.0"
 
 
-def _numba_cache_dir():
-    """Where numba caches the compiled kernels: a folder named by a digest
-    of the kernels' source, so that a change to any kernel compiles every
-    kernel anew (numba keys a cached function by its own file only: a loop
-    that calls a changed kernel of another file would run the old one).
-    In ``kernels/__pycache__`` beside their source if it can be written,
-    else in ``meshwear-numba-<uid>`` in the user's cache or the temporary
-    folder (a system-wide or container install, a user without a writable
-    HOME); folders of other digests there are removed. None when
-    ``$NUMBA_CACHE_DIR`` is set (the user's choice stands)."""
-    if _os.environ.get("NUMBA_CACHE_DIR"):
-        return None
-    import hashlib
-    import tempfile
+from .kernels import cachedir as _cachedir  # no numba import there
 
-    here = _os.path.dirname(_os.path.abspath(__file__))
-    kernels = _os.path.join(here, "kernels")
-    digest = hashlib.sha1()
-    for name in sorted(_os.listdir(kernels)):
-        if name.endswith(".py"):
-            with open(_os.path.join(kernels, name), "rb") as f:
-                digest.update(name.encode() + b"\0" + f.read())
-    user = _os.environ.get("XDG_CACHE_HOME") or _os.path.join(_os.path.expanduser("~"), ".cache")
-    uid = getattr(_os, "getuid", lambda: 0)()
-    for base in (_os.path.join(kernels, "__pycache__"),
-                 _os.path.join(user, f"meshwear-numba-{uid}"),
-                 _os.path.join(tempfile.gettempdir(), f"meshwear-numba-{uid}")):
-        folder = _os.path.join(base, f"numba-{digest.hexdigest()[:16]}")
-        if _writable(folder):
-            _forget_others(base, folder)
-            return folder
-    return None
-
-
-def _forget_others(base, keep):
-    """Remove the cache folders of other kernel sources under ``base`` (best effort)."""
-    import shutil
-
-    try:
-        names = _os.listdir(base)
-    except OSError:
-        return
-    for name in names:
-        path = _os.path.join(base, name)
-        if name.startswith("numba-") and path != keep:
-            shutil.rmtree(path, ignore_errors=True)
-
-
-def _writable(folder):
-    """Whether a file can be made in ``folder`` (made if missing): tried, as
-    permissions say nothing of a read-only mount."""
-    import tempfile
-
-    try:
-        _os.makedirs(folder, exist_ok=True)
-        with tempfile.TemporaryFile(dir=folder):
-            return True
-    except OSError:
-        return False
-
-
-_cache = _numba_cache_dir()
+_cache = _cachedir.choose()
 if _cache is not None:
     _os.environ["NUMBA_CACHE_DIR"] = _cache
     import sys as _sys

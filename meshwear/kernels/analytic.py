@@ -28,7 +28,9 @@ distance : (n,)
 """
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
+
+from .jit import njit
 
 from .contact import _named_copy, rotation_entries
 from .frames import offset, to_frame

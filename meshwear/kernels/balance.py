@@ -27,7 +27,7 @@ Arrays as in :mod:`meshwear.kernels.contact` (``area`` the (n, 4) area vectors,
 """
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .contact import FACING, rotation_entries
 

@@ -70,7 +70,9 @@ wrench : (6,)
 import types
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
+
+from .jit import njit
 
 from . import laws
 from .laws import wear_increment

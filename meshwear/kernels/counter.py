@@ -26,7 +26,7 @@ part : tuple
     it does not wear); wear moves its faces.
 """
 
-from numba import njit
+from .jit import njit
 
 from .analytic import (cylinder_planes_parallel, cylinder_planes_serial, sphere_planes_parallel,
                        sphere_planes_serial)

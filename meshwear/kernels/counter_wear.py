@@ -50,7 +50,9 @@ part : tuple
 """
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
+
+from .jit import njit
 
 from .contact import NO_CONTACT, SLIP, _named_copy, rotation_entries
 from .laws import wear_increment

@@ -12,7 +12,7 @@ it, world).
 """
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .contact import FACING, rotation_entries
 

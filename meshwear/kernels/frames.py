@@ -31,7 +31,7 @@ bounds : (16,)
 """
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .rigid import path_point
 

@@ -23,7 +23,7 @@ pynndescent's named distances: a dict from name to compiled function.
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 
 @dataclass(frozen=True)

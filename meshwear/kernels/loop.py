@@ -39,7 +39,7 @@ report
 """
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .balance import balance_offset
 from .contact import (BUILDS, PARALLEL_THRESHOLD, _named_copy, contact_parallel, contact_serial,

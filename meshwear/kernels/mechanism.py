@@ -7,7 +7,7 @@ worn body, summed over its active vertices, and its moment about the world
 origin). Twins in tests/test_mechanism.py."""
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .contact import FORCE, rotation_entries
 from .frames import moved_since_refresh, step_motion

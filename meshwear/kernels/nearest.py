@@ -35,7 +35,9 @@ neighbours : (F, 3) int64
 """
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
+
+from .jit import njit
 
 from .contact import _named_copy, rotation_entries  # noqa: F401  (re-exported for twins)
 from .frames import to_frame

@@ -5,7 +5,7 @@ quaternion (w, x, y, z), velocity, angular velocity (world frame).
 """
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .contact import _named_copy, rotation_entries
 

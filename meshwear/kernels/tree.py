@@ -28,7 +28,7 @@ faces. :func:`refit` fits them anew in O(F) on the same topology.
 """
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from ..geometry import morton_codes
 

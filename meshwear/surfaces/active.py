@@ -19,9 +19,9 @@ from dataclasses import dataclass
 
 import fcl
 import numpy as np
-from numba import njit
 from numba.typed import List
 
+from ..kernels.jit import njit
 from ..kernels.contact import FACING, FORCE, NO_CONTACT
 from ..kernels.frames import (BOUNDS_SIZE, MOTION_SIZE, moved_since_refresh as _moved,
                               step_motion as _step)
