@@ -299,6 +299,11 @@ def build_model(scene):
     SceneError, geometry.MeshError
         For input the engine cannot use, naming the key.
     """
+    # the step count first, from the longest step the run can take (an
+    # "auto" one is shorter still): a run too long is refused before any
+    # mesh is built or refined
+    periods = _periods(scene)
+    _timing(scene, scene.wear.period or (max(periods) if periods else None), math.inf)
     mechanism = None
     if scene.mechanism is not None:
         from .mechanism import Mechanism
@@ -316,7 +321,14 @@ def build_model(scene):
         for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
             if s.mechanism_body is not None:
                 _ride(mechanism, surface, j, s.mechanism_body, 0.0)
-    bodies = _build_bodies(scene, surfaces.SurfaceSet(built), mechanism)
+    unrefined = surfaces.SurfaceSet(built)
+    bodies = _build_bodies(scene, unrefined, mechanism)
+    if any(getattr(s, "resolution", None) is not None for s in scene.surfaces):
+        # a body placed inside a surface is refused before the surface is
+        # refined (its shape is the same, but for facets' sag)
+        for j, (b, config) in enumerate(zip(bodies, scene.bodies)):
+            _refuse_deep_start(scene, j, b, config, unrefined, surfaces.initial_planes(
+                unrefined, b, b.initial_pose, 2.0 * b.radius)[0])
     for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
         if getattr(s, "resolution", None) is not None and isinstance(surface,
                                                                      surfaces.MeshSurface):

@@ -129,7 +129,7 @@ def surface_faces_to_refine(scene, surface, bodies, periods, resolution):
         tri = vertices[faces]
         centre = tri.mean(axis=1)
         size = np.linalg.norm(tri - centre[:, None], axis=2).max(axis=1)
-        return index.query(centre)[0] <= reach + size
+        return _within(index, centre, reach + size)
 
     # (a face holding such a point has its centre within reach + size of it)
     select.within = lambda points: index.query(points, distance_upper_bound=reach)[0] <= reach
@@ -162,6 +162,23 @@ def _refuse_early(surface, sweeps, low, high, resolution):
         lambda points: index.query(points, distance_upper_bound=near)[0] <= near,
         np.random.default_rng(0))
     remesh.check_area(area, resolution)
+
+
+def _within(index, points, bound):
+    """(k,) bool: whether each of ``points`` has a point of the tree
+    ``index`` within its ``bound`` (m). Asked in groups of bounds within a
+    factor 2, each no farther than its largest: a search with no bound from
+    a point far from the cloud (the centre of a face a kilometre long) goes
+    through much of the tree."""
+    out = np.zeros(len(points), bool)
+    if not len(points):
+        return out
+    group = np.floor(np.log2(np.maximum(bound, np.finfo(float).tiny))).astype(np.int64)
+    for g in np.unique(group):
+        take = np.flatnonzero(group == g)
+        far = float(bound[take].max())
+        out[take] = index.query(points[take], distance_upper_bound=far)[0] <= bound[take]
+    return out
 
 
 def _relative_moves(body, surface, times):
