@@ -7,6 +7,7 @@ writes into, so a step allocates no state. Kernels see only these arrays.
 
 import logging
 import math
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -322,13 +323,9 @@ def build_model(scene):
             if s.mechanism_body is not None:
                 _ride(mechanism, surface, j, s.mechanism_body, 0.0)
     unrefined = surfaces.SurfaceSet(built)
+    if mechanism is None:
+        _refuse_before_refining(scene, built, unrefined)
     bodies = _build_bodies(scene, unrefined, mechanism)
-    if any(getattr(s, "resolution", None) is not None for s in scene.surfaces):
-        # a body placed inside a surface is refused before the surface is
-        # refined (its shape is the same, but for facets' sag)
-        for j, (b, config) in enumerate(zip(bodies, scene.bodies)):
-            _refuse_deep_start(scene, j, b, config, unrefined, surfaces.initial_planes(
-                unrefined, b, b.initial_pose, 2.0 * b.radius)[0])
     for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
         if getattr(s, "resolution", None) is not None and isinstance(surface,
                                                                      surfaces.MeshSurface):
@@ -457,9 +454,38 @@ def _ride(mechanism, surface, index, name, t):
     mechanism.surfaces.append((surface, index, name, surface.placement))
 
 
-def _build_bodies(scene, surface_set, mechanism=None):
+def _refuse_before_refining(scene, built, unrefined):
+    """Before any part is refined, where a mesh surface is to be: a body
+    placed inside a surface, and a surface's resolution too fine for this
+    machine from the bodies' coarse meshes (their vertices are among the
+    refined ones': :func:`meshwear.reach.refuse_early`), are refused without
+    the bodies' refinement first (a turning shaft's 80 000 faces take
+    seconds). The deep-start check is made again once the parts are refined
+    (their facets' sag)."""
+    refined = [j for j, (surface, s) in enumerate(zip(built, scene.surfaces))
+               if getattr(s, "resolution", None) is not None
+               and isinstance(surface, surfaces.MeshSurface)]
+    if not refined:
+        return
+    coarse = _build_bodies(scene, unrefined, coarse=True)
+    for j, (b, config) in enumerate(zip(coarse, scene.bodies)):
+        _refuse_deep_start(scene, j, b, config, unrefined, surfaces.initial_planes(
+            unrefined, b, b.initial_pose, 2.0 * b.radius)[0])
+    for j in refined:
+        s = scene.surfaces[j]
+        try:
+            reach.refuse_early(scene, built[j], coarse, _periods(scene), s.resolution)
+        except geometry.MeshError as err:
+            raise SceneError(scene.source, _part_key(f"surface[{j}]", s), str(err)) from None
+
+
+def _build_bodies(scene, surface_set, mechanism=None, coarse=False):
+    """The :class:`BodyModel` of every body; with ``coarse``, their meshes
+    as given (no ``resolution``: no mechanism either)."""
     bodies = []
     for j, b in enumerate(scene.bodies):
+        if coarse:
+            b = dataclasses.replace(b, resolution=None, resolution_reach=None)
         try:
             bodies.append(_build_body(scene, j, b, surface_set, mechanism))
         except geometry.MeshError as err:

@@ -28,6 +28,9 @@ REACH_SAMPLES = (64, 4096)
 #: half-diagonal of a cell
 CLOUD_POINTS = 2**22
 THIN_CELL = 0.25
+#: points of the coarsest samples the early refusal looks at, at most (a
+#: body's every k-th vertex beyond: a lower bound still)
+EARLY_POINTS = 2**19
 #: points of the sweep transformed at once (memory: 24 B each, a few times)
 CHUNK_POINTS = 2**20
 
@@ -91,16 +94,9 @@ def surface_faces_to_refine(scene, surface, bodies, periods, resolution):
 
     if any(b.motion.dynamic_axes == "all" for b in bodies) or getattr(surface, "rider", False):
         return None
-    periods = {round(p, 12) for p in periods}
-    window = scene.run.duration
-    if len(periods) == 1:
-        window = min(window, periods.pop())
+    window = _window(scene, periods)
     low, high = surface.vertices.min(axis=0), surface.vertices.max(axis=0)
-    sweeps = []
-    for b in bodies:
-        margin = surfaces.margin_of(scene, b)
-        moves = _relative_moves(b, surface, np.linspace(0.0, window, REACH_SAMPLES[0] + 1))
-        sweeps.append((b, margin, moves))
+    sweeps = _coarsest(scene, surface, bodies, window)
     _refuse_early(surface, sweeps, low, high, resolution)
     clouds, reach = [], 0.0
     for b, margin, moves in sweeps:
@@ -136,10 +132,46 @@ def surface_faces_to_refine(scene, surface, bodies, periods, resolution):
     return select
 
 
+def _window(scene, periods):
+    """The time (s) the bodies' sweep is sampled over: one cycle when the
+    moving parts share one period, else the run."""
+    periods = {round(p, 12) for p in periods}
+    window = scene.run.duration
+    if len(periods) == 1:
+        window = min(window, periods.pop())
+    return window
+
+
+def _coarsest(scene, surface, bodies, window):
+    """``(body, margin, moves)`` of each body at the coarsest samples of its sweep."""
+    return [(b, surfaces.margin_of(scene, b),
+             _relative_moves(b, surface, np.linspace(0.0, window, REACH_SAMPLES[0] + 1)))
+            for b in bodies]
+
+
+def refuse_early(scene, surface, bodies, periods, resolution):
+    """Refuse a mesh surface's ``resolution`` (m) too fine for this machine
+    before any part is refined, from the coarsest samples of ``bodies``'
+    sweep (their meshes as given: the vertices of a refined body include
+    them, its margin is no smaller): :func:`_refuse_early`. Nothing to refuse
+    where :func:`surface_faces_to_refine` takes every face (its refinement
+    checks their whole area at once).
+
+    Raises
+    ------
+    geometry.MeshError
+        For a resolution too fine for this machine."""
+    if any(b.motion.dynamic_axes == "all" for b in bodies) or getattr(surface, "rider", False):
+        return
+    low, high = surface.vertices.min(axis=0), surface.vertices.max(axis=0)
+    _refuse_early(surface, _coarsest(scene, surface, bodies, _window(scene, periods)), low,
+                  high, resolution)
+
+
 def _refuse_early(surface, sweeps, low, high, resolution):
     """Refuse ``resolution`` from the coarsest samples of the bodies' sweeps
     (``(body, margin, moves)``): the surface within the smallest margin of
-    their vertices at those instants (of :data:`CLOUD_POINTS` at most) is
+    their vertices at those instants (of :data:`EARLY_POINTS` at most) is
     within reach of the finer samples too (the instants are among theirs),
     so refined whatever the passes do."""
     from scipy.spatial import cKDTree
@@ -148,12 +180,12 @@ def _refuse_early(surface, sweeps, low, high, resolution):
     clouds = []
     for b, _, (M, c) in sweeps:
         vertices = b.reference_vertices
-        vertices = vertices[::max(1, -(-len(vertices) * len(c) // CLOUD_POINTS))]
+        vertices = vertices[::max(1, -(-len(vertices) * len(c) // EARLY_POINTS))]
         clouds.append(_swept_cloud(vertices, M, c, low - near, high + near, None)[0])
     cloud = np.concatenate(clouds)
     if not len(cloud):
         return
-    index = cKDTree(cloud)
+    index = cKDTree(cloud, balanced_tree=False, compact_nodes=False)
     tri = surface.vertices[surface.faces]
     lo, hi = cloud.min(axis=0) - near, cloud.max(axis=0) + near
     faces = surface.faces[np.all((tri.max(axis=1) >= lo) & (tri.min(axis=1) <= hi), axis=1)]
