@@ -208,7 +208,8 @@ def _within(index, points, bound):
     group = np.floor(np.log2(np.maximum(bound, np.finfo(float).tiny))).astype(np.int64)
     for g in np.unique(group):
         take = np.flatnonzero(group == g)
-        far = float(bound[take].max())
+        # (a bound the search may take as strict: one ulp farther)
+        far = float(np.nextafter(bound[take].max(), np.inf))
         out[take] = index.query(points[take], distance_upper_bound=far)[0] <= bound[take]
     return out
 
