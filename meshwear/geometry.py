@@ -278,17 +278,23 @@ def _merge_vertices(vertices, faces, tolerance):
     from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree
 
-    pairs = cKDTree(vertices).query_pairs(tolerance, output_type="ndarray")
-    if len(pairs) == 0:
+    # the exact copies first (an STL file has each vertex once per face):
+    # the search for near ones then sees each point once, six times fewer
+    unique, first, of_unique = np.unique(vertices, axis=0, return_index=True,
+                                         return_inverse=True)
+    pairs = cKDTree(unique).query_pairs(tolerance, output_type="ndarray")
+    if len(pairs) == 0 and len(unique) == len(vertices):
         return vertices, faces
-    n = len(vertices)
+    n = len(unique)
     graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
-    _, label = connected_components(graph, directed=False)
-    _, first, inverse = np.unique(label, return_index=True, return_inverse=True)
-    order = np.argsort(first)            # keep the vertices' original order
+    count, label = connected_components(graph, directed=False)
+    # each cluster's first vertex, the clusters in the order of their first vertices
+    cluster_first = np.full(count, len(vertices))
+    np.minimum.at(cluster_first, label, first)
+    order = np.argsort(cluster_first)
     rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    return _arrays(vertices[first[order]], rank[inverse][faces])
+    rank[order] = np.arange(count)
+    return _arrays(vertices[cluster_first[order]], rank[label[of_unique.ravel()]][faces])
 
 
 def _doubled_areas(vertices, faces):

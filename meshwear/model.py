@@ -7,11 +7,12 @@ writes into, so a step allocates no state. Kernels see only these arrays.
 
 import logging
 import math
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import geometry, remesh, surfaces
+from . import geometry, reach, remesh, surfaces
 from .dynamics import OwnMotions
 from .elastic import HalfSpace, PatchError
 from .elastic import step as elastic_step
@@ -23,7 +24,6 @@ from .motion import (BalancedMotion, FixedMotion, FreeMotion, GuidedMotion, Mech
                      PrescribedMotion)
 from .scene import SceneError
 from .stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_stiffness
-from .surfaces.base import quaternion_matrix
 
 #: meshwear's own motions, the dynamics of a model without a mechanism
 OWN_MOTIONS = OwnMotions()
@@ -300,6 +300,11 @@ def build_model(scene):
     SceneError, geometry.MeshError
         For input the engine cannot use, naming the key.
     """
+    # the step count first, from the longest step the run can take (an
+    # "auto" one is shorter still): a run too long is refused before any
+    # mesh is built or refined
+    periods = _periods(scene)
+    _timing(scene, scene.wear.period or (max(periods) if periods else None), math.inf)
     mechanism = None
     if scene.mechanism is not None:
         from .mechanism import Mechanism
@@ -317,12 +322,16 @@ def build_model(scene):
         for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
             if s.mechanism_body is not None:
                 _ride(mechanism, surface, j, s.mechanism_body, 0.0)
-    bodies = _build_bodies(scene, surfaces.SurfaceSet(built), mechanism)
+    unrefined = surfaces.SurfaceSet(built)
+    if mechanism is None:
+        _refuse_before_refining(scene, built, unrefined)
+    bodies = _build_bodies(scene, unrefined, mechanism)
     for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
         if getattr(s, "resolution", None) is not None and isinstance(surface,
                                                                      surfaces.MeshSurface):
             try:
-                built[j] = surface.refined(s, _surface_faces_to_refine(scene, surface, bodies))
+                built[j] = surface.refined(s, reach.surface_faces_to_refine(
+                    scene, surface, bodies, _periods(scene), s.resolution))
             except geometry.MeshError as err:
                 raise SceneError(scene.source, _part_key(f"surface[{j}]", s), str(err)) from None
     for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
@@ -445,78 +454,44 @@ def _ride(mechanism, surface, index, name, t):
     mechanism.surfaces.append((surface, index, name, surface.placement))
 
 
-def _build_bodies(scene, surface_set, mechanism=None):
+def _refuse_before_refining(scene, built, unrefined):
+    """Before any part is refined, where a mesh surface is to be: a body
+    placed inside a surface, and a surface's resolution too fine for this
+    machine from the bodies' coarse meshes (their vertices are among the
+    refined ones': :func:`meshwear.reach.refuse_early`), are refused without
+    the bodies' refinement first (a turning shaft's 80 000 faces take
+    seconds). The deep-start check is made again once the parts are refined
+    (their facets' sag)."""
+    refined = [j for j, (surface, s) in enumerate(zip(built, scene.surfaces))
+               if getattr(s, "resolution", None) is not None
+               and isinstance(surface, surfaces.MeshSurface)]
+    if not refined:
+        return
+    coarse = _build_bodies(scene, unrefined, coarse=True)
+    for j, (b, config) in enumerate(zip(coarse, scene.bodies)):
+        _refuse_deep_start(scene, j, b, config, unrefined, surfaces.initial_planes(
+            unrefined, b, b.initial_pose, 2.0 * b.radius)[0])
+    for j in refined:
+        s = scene.surfaces[j]
+        try:
+            reach.refuse_early(scene, built[j], coarse, _periods(scene), s.resolution)
+        except geometry.MeshError as err:
+            raise SceneError(scene.source, _part_key(f"surface[{j}]", s), str(err)) from None
+
+
+def _build_bodies(scene, surface_set, mechanism=None, coarse=False):
+    """The :class:`BodyModel` of every body; with ``coarse``, their meshes
+    as given (no ``resolution``: no mechanism either)."""
     bodies = []
     for j, b in enumerate(scene.bodies):
+        if coarse:
+            b = dataclasses.replace(b, resolution=None, resolution_reach=None)
         try:
             bodies.append(_build_body(scene, j, b, surface_set, mechanism))
         except geometry.MeshError as err:
             # the mesh loader names the mesh file; add the scene file and the key
             raise SceneError(scene.source, _part_key(f"body[{j}]", b), str(err)) from None
     return tuple(bodies)
-
-
-#: a worn surface's reach is sampled at this many instants at least, and at
-#: most at this many: denser until no body vertex moves farther than the
-#: margin between two of them
-REACH_SAMPLES = (64, 4096)
-
-
-def _surface_faces_to_refine(scene, surface, bodies):
-    """Which faces of a mesh surface ``resolution`` refines, as a selection
-    made anew at each pass of the refinement: those within the active-set
-    margin of a body at some instant of the run (sampled over one cycle when
-    the moving parts share one period, else over the run, until no vertex
-    moves more than the margin between samples; their spacing added to the
-    margin). None (all faces) if a body is free (it may land anywhere) or
-    moves too fast to sample."""
-    from scipy.spatial import cKDTree
-
-    if any(b.motion.dynamic_axes == "all" for b in bodies) or getattr(surface, "rider", False):
-        return None
-    periods = {round(p, 12) for p in _periods(scene)}
-    window = scene.run.duration
-    if len(periods) == 1:
-        window = min(window, periods.pop())
-    low, high = surface.vertices.min(axis=0), surface.vertices.max(axis=0)
-    clouds, reach = [], 0.0
-    for b in bodies:
-        margin = surfaces.margin_of(scene, b)
-        pose = b.initial_pose.copy()
-        n = REACH_SAMPLES[0]
-        while True:
-            points = []
-            for t in np.linspace(0.0, window, n + 1):
-                b.motion.place(pose, t)
-                rotation, frame = surface.motion.frame(t)
-                x = pose[0:3] + b.reference_vertices @ quaternion_matrix(pose[3:7]).T
-                points.append((x - frame[0]) @ rotation)
-            step = max(float(np.linalg.norm(q - p, axis=1).max())
-                       for p, q in zip(points, points[1:]))
-            if step <= margin or n >= REACH_SAMPLES[1]:
-                break
-            n *= 2
-        if step > 4.0 * margin:
-            return None
-        r = margin + 0.5 * step
-        points = np.concatenate(points)
-        near = np.all((points >= low - r) & (points <= high + r), axis=1)
-        clouds.append(points[near])
-        reach = max(reach, r)
-    cloud = np.concatenate(clouds)
-    if not len(cloud):
-        return np.zeros(len(surface.faces), bool)
-    index = cKDTree(cloud)
-
-    def select(vertices, faces):
-        # a face is within reach of a point if its centre is within reach
-        # and the face's own size of it
-        tri = vertices[faces]
-        centre = tri.mean(axis=1)
-        size = np.linalg.norm(tri - centre[:, None], axis=2).max(axis=1)
-        return index.query(centre)[0] <= reach + size
-
-    return select
 
 
 def _periods(scene):
@@ -598,7 +573,8 @@ def _build_body(scene, index, body, surface_set, mechanism=None):
     refinement = None
     if body.resolution is not None:
         vertices, faces, refinement = remesh.refine_part(
-            body, vertices, faces, _faces_to_refine(scene, body, vertices, faces, surface_set))
+            body, vertices, faces,
+            reach.faces_to_refine(scene, body, vertices, faces, surface_set))
     needs_inertia = body.motion in ("free", "guided", "mechanism")
     area = geometry.tributary_areas(vertices, faces)
     riding = body.motion == "mechanism"
@@ -679,46 +655,6 @@ IMPACT_DEPTH = 0.25
 def _thinnest(vertices):
     """The smallest extent of a body's bounding box (m)."""
     return float(np.ptp(vertices, axis=0).min())
-
-
-#: a face of a body that is not free can come into contact where it faces a
-#: surface within this fraction of the body's bounding-box diagonal
-REFINE_REACH = 0.1
-
-
-def _faces_to_refine(scene, body, vertices, faces, surface_set):
-    """Faces ``resolution`` refines: all of a free body (it may land on any
-    face); of a guided, prescribed or fixed one (which only translates) the
-    faces that face a surface within :data:`REFINE_REACH` of its size at the
-    start (its path's displacement included); all of one that turns.
-
-    With ``resolution_reach`` given, the faces within it, chosen anew at
-    each pass of the refinement (:func:`meshwear.remesh.refine`) on the
-    part's true surface (a primitive's vertices put on it, each face's sag
-    allowed for): the faces of a coarse sphere are a millimetre wide, and
-    taken whole a 10 mm ball with a 20 µm reach had 200 000 vertices refined
-    to 7 µm over 9 mm² where its cap within reach is 1.3 mm²."""
-    if body.motion in ("free", "mechanism") or (body.path is not None
-                                                and body.path.rotation is not None):
-        return None
-    R = np.array(rotation_entries(np.asarray(body.orientation, float))).reshape(3, 3)
-    offset = np.asarray(body.position, float) + Path(body.path).displacement(0.0)
-    reach = body.resolution_reach
-    if reach is None:
-        reach = REFINE_REACH * float(np.linalg.norm(np.ptp(vertices, axis=0)))
-        return surfaces.contact_faces(vertices @ R.T + offset, faces, surface_set, reach)
-
-    def select(vertices, faces, every=False):
-        true = geometry.snap_to_primitive(body.shape, vertices, faces)
-        sag = None if every else geometry.facet_sag(body.shape, true, faces)
-        return surfaces.contact_faces(true @ R.T + offset, faces, surface_set, reach, sag,
-                                      every)
-
-    # (the faces wholly within reach are surely refined: too fine a
-    # resolution is refused before the first pass, not after the passes
-    # have filled the memory)
-    select.surely = lambda vertices, faces: select(vertices, faces, every=True)
-    return select
 
 
 #: an initial penetration deeper than this fraction of the body's smallest

@@ -80,15 +80,17 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=None, return_m
         unselected faces are split only where needed to stay conforming. A
         callable ``face_mask(vertices, faces)`` selects anew after each pass
         (a big face of which only a part is to be refined: its children
-        away from that part are left); its attribute ``surely(vertices,
-        faces)``, if it has one, gives the faces it refines whatever the
-        passes (their area is checked against ``max_faces`` at once).
+        away from that part are left); its attributes ``surely(vertices,
+        faces)`` (the faces it refines whatever the passes) and
+        ``within(points)`` ((k,) bool: points every face holding which it
+        refines), if it has them, give the area checked against
+        ``max_faces`` before each pass (:func:`_surely_refined_area`).
     max_faces : int, optional
-        Refuse (MeshError) rather than build a larger mesh: at once when the
-        selected area alone needs more faces (a triangle with edges <=
-        ``resolution`` covers sqrt(3)/4 resolution² at most), else as soon as
-        a pass makes more. Default: :func:`face_limit` (this machine's
-        available memory, at most :data:`MAX_FACES`).
+        Refuse (MeshError) rather than build a larger mesh: before a pass
+        when the area surely refined alone needs more faces (a triangle with
+        edges <= ``resolution`` covers sqrt(3)/4 resolution² at most), else
+        as soon as a pass makes more. Default: :func:`face_limit` (this
+        machine's available memory, at most :data:`MAX_FACES`).
     return_mask : bool
         Also return which faces come from selected ones.
 
@@ -106,24 +108,19 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=None, return_m
             else np.asarray(face_mask, bool).copy())
     if mask.shape != (len(F),):
         raise ValueError(f"face_mask has shape {mask.shape}, expected ({len(F)},)")
-    # (a selection made anew each pass may keep far less than its first one:
-    # only the faces it says it surely refines, if it says, are counted)
-    surely = getattr(select, "surely", None)
-    counted = (mask if select is None else surely(V, F) if surely is not None
-               else np.zeros(len(F), bool))
-    area = 0.5 * float(_doubled_areas(V, F[counted]).sum())
-    cell = _LARGEST_UNIT_TRIANGLE * resolution**2     # 0.0 for a subnormal resolution
-    least = area / cell if cell > 0.0 else float("inf")
     why = "the limit asked"
     if max_faces is None:
         max_faces, why = face_limit()
-    if not least <= max_faces:
-        raise MeshError(f"refining to resolution {resolution:g} m needs at least {least:.3g} "
-                        f"faces, more than {max_faces} ({why}); give a coarser resolution")
+    rng = np.random.default_rng(0)        # seeded: the same refusal every time
     first_count = len(F)
     while True:
         if select is not None and len(F) > first_count:
             mask = select(V, F)
+        # before each pass: the area surely refined needs this many faces at
+        # least (a fixed selection's is known before the first; one made anew
+        # each pass knows more of it as its faces shrink to the part within reach)
+        if select is not None or len(F) == first_count:
+            check_area(_surely_refined_area(V, F, mask, select, rng), resolution, max_faces, why)
         lengths = _edge_lengths(V, F)
         need = mask & (lengths.max(axis=1) > resolution)
         if not need.any():
@@ -159,6 +156,63 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=None, return_m
         if len(F) > max_faces:
             raise MeshError(f"refining to resolution {resolution:g} m needs more than {max_faces} "
                             f"faces ({why}); give a coarser resolution")
+
+
+#: points drawn on a selection's faces to estimate the area within its reach
+AREA_SAMPLES = 4096
+
+
+def check_area(area, resolution, max_faces=None, why="the limit asked"):
+    """Refuse (MeshError) to refine ``area`` (m²) to ``resolution`` (m) when
+    it needs more than ``max_faces`` faces (default: :func:`face_limit`): a
+    triangle with edges <= ``resolution`` covers sqrt(3)/4 resolution² at
+    most, so no refinement of it makes fewer."""
+    if max_faces is None:
+        max_faces, why = face_limit()
+    cell = _LARGEST_UNIT_TRIANGLE * resolution**2     # 0.0 for a subnormal resolution
+    least = area / cell if cell > 0.0 else float("inf")
+    if not least <= max_faces:
+        raise MeshError(f"refining to resolution {resolution:g} m needs at least {least:.3g} "
+                        f"faces, more than {max_faces} ({why}); give a coarser resolution")
+
+
+def _surely_refined_area(V, F, mask, select, rng):
+    """Area (m²) that the refinement refines whatever its passes do: the
+    selected faces' (a fixed selection), else what the selection says it
+    surely refines: the faces of its ``surely(V, F)``, or the part of the
+    selected faces where its ``within(points)`` holds (:func:`sampled_area`:
+    a thin band across big faces is missed at first, and seen once the
+    passes have cut them near it)."""
+    if select is None:
+        return 0.5 * float(_doubled_areas(V, F[mask]).sum())
+    area = 0.0
+    surely = getattr(select, "surely", None)
+    if surely is not None:
+        area = 0.5 * float(_doubled_areas(V, F[surely(V, F)]).sum())
+    within = getattr(select, "within", None)
+    if within is not None:
+        area = max(area, sampled_area(V, F[mask], within, rng))
+    return area
+
+
+def sampled_area(vertices, faces, within, rng):
+    """Area (m²) of the triangles ``faces`` where ``within(points)`` ((k,)
+    bool) holds, estimated from :data:`AREA_SAMPLES` points drawn on them
+    by area with ``rng`` (a numpy Generator), three standard deviations
+    low (hits - 3 sqrt(hits) of them): about a lower bound."""
+    areas = 0.5 * _doubled_areas(vertices, faces)
+    total = float(areas.sum())
+    if not total > 0.0:
+        return 0.0
+    pick = np.minimum(np.searchsorted(np.cumsum(areas), rng.random(AREA_SAMPLES) * total),
+                      len(faces) - 1)
+    # uniform on each triangle: the square root of one uniform for the first corner's share
+    u, v = rng.random((2, AREA_SAMPLES))
+    s = np.sqrt(u)[:, None]
+    tri = vertices[faces[pick]]
+    points = (1.0 - s) * tri[:, 0] + s * ((1.0 - v)[:, None] * tri[:, 1] + v[:, None] * tri[:, 2])
+    hits = float(np.count_nonzero(within(points)))
+    return total * max(hits - 3.0 * np.sqrt(hits), 0.0) / AREA_SAMPLES
 
 
 def _bisect(F, mask, eid, midpoint, marked, longest):

@@ -8,6 +8,12 @@ by ``make fuzz`` (``python -m tests.fuzzing``: every case, with a count of
 the clean ones)::
 
     .venv/bin/python -m tests.fuzzing [--scenes pin_on_disc cube_toss] [--limit N]
+    .venv/bin/python -m tests.fuzzing --limits     # the extreme cases of LIMIT_CASES only
+
+:data:`LIMIT_CASES` are extreme resolutions and sizes on every kind of
+surface (turning, worn, on a mechanism's body, the elastic half-space), put
+through ``meshwear check`` (:func:`check_probe`): each is refused with one
+line naming its key within a second, before any heavy work.
 
 A case is clean when it ends with exit 0 and nothing on stderr but
 ``meshwear:`` notices (a valid input), or with exit 2 or 3 and exactly one
@@ -95,6 +101,44 @@ def mesh_cases():
     ]
 
 
+#: extreme resolutions and sizes on every kind of surface: ``(kind, scene,
+#: overrides[, key named])``, each refused by ``meshwear check`` (exit 2, one
+#: line naming the key, by default the part of the first one) within a second (docs/outputs.md, "Limits checked before
+#: any work"). "turning": a mesh surface turning under a body; "worn": a
+#: worn mesh surface, refined where the bodies reach it; "mechanism": parts
+#: on MuJoCo bodies; "half-space": the elastic half-space contact
+LIMIT_CASES = (
+    ("turning", "pin_on_turning_disc", (("surface[0].resolution", 1e-5),)),
+    ("turning", "pin_on_turning_disc", (("surface[0].resolution", 1e-9),)),
+    ("turning", "pin_on_turning_disc", (("surface[0].resolution", TINY),)),
+    ("turning", "pin_on_turning_disc", (("body[0].resolution", 1e-9),)),
+    ("turning", "pin_on_turning_disc", (("body[0].shape.radius", 1.0),)),
+    ("turning", "pin_on_turning_disc", (("run.dt", 1e-300),)),
+    ("turning", "gear_pair", (("surface[0].resolution", 1e-7),)),
+    ("turning", "gear_pair", (("run.duration", 1e300),)),
+    ("worn", "pin_on_worn_disc", (("surface[0].resolution", 1e-6),)),
+    ("worn", "pin_on_worn_disc", (("surface[0].resolution", 1e-300),)),
+    ("worn", "pin_on_worn_disc", (("surface[0].shape.height", 1e6),), "body[0].position"),
+    ("worn", "pin_on_worn_disc", (("run.dt", 1e-300),)),
+    ("worn", "cylinder_on_worn_flat", (("surface[0].resolution", 1e-7),)),
+    ("worn", "cylinder_on_worn_flat", (("body[0].shape.height", 10.0),)),
+    ("worn", "shaft_in_worn_bushing", (("surface[0].resolution", 1e-6),)),
+    ("mechanism", "mechanisms/pendulum_in_bushing", (("surface[0].resolution", 1e-5),)),
+    ("mechanism", "mechanisms/pendulum_in_bushing", (("body[0].resolution", 1e-9),)),
+    ("mechanism", "mechanisms/pin_on_disc", (("surface[0].resolution", 1e-6),)),
+    ("mechanism", "mechanisms/pin_on_disc", (("body[0].shape.radius", 10.0),)),
+    ("mechanism", "mechanisms/gear_pair_torque", (("body[0].resolution", 1e-7),)),
+    ("mechanism", "mechanisms/slider_crank", (("run.dt", 1e-300),)),
+    ("half-space", "validation/hertz_ball", (("body[0].resolution", 1e-7),)),
+    ("half-space", "validation/hertz_ball", (("body[0].resolution", 1e-6),
+                                             ("body[0].resolution_reach", 1.0))),
+    ("half-space", "validation/hertz_ball", (("body[0].shape.radius", 10.0),)),
+    ("half-space", "validation/hertz_ball", (("run.duration", 1e300),)),
+    ("half-space", "sphere_on_flat_fretting_elastic", (("body[0].resolution", 1e-7),)),
+    ("half-space", "sphere_on_flat_fretting_elastic", (("body[0].shape.radius", 10.0),)),
+)
+
+
 class Outcome:
     """What a probe did: ``code`` (0, 2, 3, or None for an escaped
     exception), ``stderr``, ``seconds``, ``error`` (the escaped exception)."""
@@ -150,6 +194,43 @@ def probe(scene_path, overrides=(), steps=PROBE_STEPS):
     return Outcome(code, stderr.getvalue(), time.perf_counter() - start)
 
 
+def check_probe(scene_path, overrides=()):
+    """One input through ``meshwear check`` in this process (its exit path
+    included, its report dropped), timed: an :class:`Outcome`."""
+    from meshwear import cli
+
+    stderr = io.StringIO()
+    start = time.perf_counter()
+    try:
+        with contextlib.redirect_stderr(stderr), contextlib.redirect_stdout(io.StringIO()):
+            code = cli.exit_path(lambda: cli._check(str(scene_path), tuple(overrides)))
+    except BaseException as err:  # noqa: BLE001 - a finding, reported
+        return Outcome(None, stderr.getvalue(), time.perf_counter() - start, err)
+    return Outcome(code, stderr.getvalue(), time.perf_counter() - start)
+
+
+def limit_refused(outcome, case, seconds=1.0):
+    """Whether a case of :data:`LIMIT_CASES` ended as it must: exit 2 with
+    one line naming its key, within ``seconds``."""
+    named = case[3] if len(case) > 3 else case[2][0][0].split(".")[0]
+    return (outcome.code == 2 and outcome.clean and named in outcome.stderr
+            and outcome.seconds <= seconds)
+
+
+def check_limits(cases=LIMIT_CASES, seconds=1.0):
+    """Every case of :data:`LIMIT_CASES` through :func:`check_probe` twice
+    (the first loads or compiles the kernels its path calls: the second is
+    timed); ``[(kind, scene, overrides, outcome, as it must)]``."""
+    out = []
+    for case in cases:
+        kind, stem, overrides = case[:3]
+        path = EXAMPLES / f"{stem}.toml"
+        check_probe(path, overrides)
+        outcome = check_probe(path, overrides)
+        out.append((kind, stem, overrides, outcome, limit_refused(outcome, case, seconds)))
+    return out
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description="run the fuzz corpus, count clean cases")
     parser.add_argument("--scenes", nargs="*", default=list(SCENES))
@@ -158,7 +239,16 @@ def main(argv=None):
     parser.add_argument("-v", "--verbose", action="store_true", help="name each case first")
     parser.add_argument("--slow", type=float, default=1.0,
                         help="seconds beyond which a refused case counts as slow")
+    parser.add_argument("--limits", action="store_true",
+                        help="the extreme cases of LIMIT_CASES only")
     args = parser.parse_args(argv)
+    limits = check_limits(seconds=args.slow)
+    for kind, stem, overrides, outcome, ok in limits:
+        print(f"{'ok  ' if ok else 'FAIL'} {kind} {stem} {dict(overrides)}: {outcome!r}"[:300])
+    print(f"{sum(ok for *_, ok in limits)} of {len(limits)} extreme cases refused by check "
+          f"within {args.slow:g} s")
+    if args.limits:
+        return 0 if all(ok for *_, ok in limits) else 1
     cases = list(scene_cases(args.scenes))[args.start:][: args.limit]
     clean = slow = 0
     findings = {}
@@ -196,7 +286,7 @@ def main(argv=None):
             print(f"  {stem} {key} = {shown}: {outcome!r}"[:400])
     print(f"{clean} of {len(cases)} cases clean ({slow} slow refusals) in "
           f"{time.perf_counter() - start:.0f} s")
-    return 0 if clean == len(cases) else 1
+    return 0 if clean == len(cases) and all(ok for *_, ok in limits) else 1
 
 
 if __name__ == "__main__":
