@@ -8,7 +8,7 @@ import cases
 from meshwear import geometry, jump_geometry, wear
 from meshwear.model import build_model, initial_state
 from meshwear.scene import load_scene
-from meshwear.simulate import run
+from meshwear.simulate import inverted, run
 
 #: a 10 mm ball fretting +-0.1 mm under 50 N on a plane, archard, cycle jumping
 #: to a cap 1.69 mm deep: the reported 2e4 cycles at k = 1e-10 shortened to
@@ -167,3 +167,26 @@ def test_fold_room_of_a_vertex_pushed_through_its_neighbours():
     ring = np.setdiff1d(faces[around], [apex])
     assert distance > float((vertices[apex] - vertices[ring[0]]) @ axis)
     assert jump_geometry.fold_room(body, vertices, np.full_like(vertices, 0.3)) == np.inf
+
+
+def test_the_message_of_folded_faces_says_what_folded_them():
+    """Faces folded by steps: the mesh cannot follow the wear (refine it,
+    shorten the run); reached by a cycle jump: the jump (lower the
+    tolerance or resolve every cycle)."""
+    vertices, faces, normals = _ball(1)
+
+    class Body:
+        name = "ball"
+        reference_vertices = vertices
+
+    class State:
+        time, resolved = 1.5, True
+
+    s = type("S", (), {"wear_depth": np.full(len(vertices), 2e-4)})()
+    message = inverted(Body, s, faces[:3], State)
+    assert "inverted 3 triangle(s)" in message and "refine the mesh" in message
+    assert "0.0002 m" in message
+    State.resolved = False
+    message = inverted(Body, s, faces[:3], State)
+    assert "cycle jump" in message and "wear.tolerance" in message
+    assert "refine" not in message
