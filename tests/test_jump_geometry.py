@@ -169,6 +169,39 @@ def test_fold_room_of_a_vertex_pushed_through_its_neighbours():
     assert jump_geometry.fold_room(body, vertices, np.full_like(vertices, 0.3)) == np.inf
 
 
+def test_a_jump_is_cut_to_the_share_its_mesh_allows():
+    """:func:`meshwear.jump_geometry.cut` on a jump of an icosahedron whose
+    vertex wore inwards in the measured cycle: its fold bound is
+    :data:`meshwear.jump_geometry.FOLD` of the room the jump's moves leave,
+    and a move of the body along its axis past the reach of the vertices
+    measured is cut to the reach, whichever is shorter."""
+    from types import SimpleNamespace
+
+    vertices, faces, normals = _ball(0)
+    body = SimpleNamespace(faces=faces, reference_face_normals=normals,
+                           wear_direction=np.zeros((0, 3)))
+    apex = 0
+    axis = vertices[apex] / np.linalg.norm(vertices[apex])
+    start = vertices.copy()
+    start[apex] += 1e-3 * axis                # a cycle ago, 1 mm further out
+    rate = np.zeros(len(vertices))
+    rate[apex] = 1e-3
+    s = SimpleNamespace(vertices=vertices)
+    model = SimpleNamespace(bodies=[body])
+    room = jump_geometry.fold_room(body, vertices, vertices - start)   # in cycles
+    assert np.isfinite(room)
+    jump = 4.0 * room
+    results = [(jump * rate, 0.5, None)]
+    which, share = jump_geometry.cut(model, [s], [(None, start)], [rate], results, None, 1,
+                                     [np.inf])
+    assert which == "fold" and share == pytest.approx(jump_geometry.FOLD * room / jump)
+    which, share = jump_geometry.cut(model, [s], [(None, start)], [rate], results, None, 1,
+                                     [0.01])
+    assert which == "reach" and share == pytest.approx(0.01 / 0.5)
+    short = [(0.1 * room * rate, 0.001, None)]
+    assert jump_geometry.cut(model, [s], [(None, start)], [rate], short, None, 1, [0.01]) is None
+
+
 def test_the_message_of_folded_faces_says_what_folded_them():
     """Faces folded by steps: the mesh cannot follow the wear (refine it,
     shorten the run); reached by a cycle jump: the jump (lower the
