@@ -29,10 +29,10 @@ from .surfaces.active import query_reach
 
 #: a jump takes a face at most this fraction of the way to folding over:
 #: its displacements, over this fraction, fold none (a vertex at the rim of
-#: a cap worn flat, on a sphere, passes its unworn neighbour only when moved
-#: 1 / sin^2(theta) times as far as wearing it flush takes, theta the rim's
-#: slope: a jump that wears caps up to 45 degrees to the surface's shape is
-#: not cut)
+#: a cap worn flat on a sphere, its outer neighbour unworn, folds their
+#: face only when moved 1 / sin^2(theta) times as far as wearing it flush
+#: takes, theta the rim's slope: a jump that wears a rim sloping up to 45
+#: degrees to the surface's shape is not cut)
 FOLD = 0.5
 
 
