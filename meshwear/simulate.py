@@ -266,10 +266,27 @@ def check(model, state, face_normals):
             touched = worn[body.faces].any(axis=1)
             flipped = inverted_faces(normals[touched], s.vertices, body.faces[touched])
             if len(flipped):
-                raise NumericalError(
-                    f"body {body.name!r}: wear inverted {len(flipped)} triangle(s) at "
-                    f"t = {state.time:.6g} s (wear deeper than the local mesh spacing or "
-                    "thickness: refine the mesh or lower the wear coefficient)")
+                raise NumericalError(inverted(body, s, body.faces[touched][flipped], state))
+
+
+def inverted(body, s, faces, state):
+    """The message of the worn faces ``faces`` (k, 3) of ``body`` (state
+    ``s``) found folded over at ``state``'s time: how deep their corners
+    wore against their edges, and what to do, which depends on whether
+    steps or a cycle jump brought them there (a jump is bounded so as not
+    to fold a face: docs/model.md, "Long durations")."""
+    x = body.reference_vertices[faces]
+    edge = float(np.linalg.norm(x - np.roll(x, 1, axis=1), axis=2).min())
+    deepest = float(s.wear_depth[np.unique(faces)].max())
+    where = (f"body {body.name!r}: wear inverted {len(faces)} triangle(s) at "
+             f"t = {state.time:.6g} s (their corners worn up to {deepest:.3g} m, their "
+             f"shortest edge {edge:.3g} m)")
+    if not state.resolved:
+        return (f"{where}: a cycle jump moved the mesh further than it can follow; lower "
+                "wear.tolerance, or resolve every cycle (wear.acceleration = \"none\")")
+    return (f"{where}: the mesh cannot follow the wear there, or it wore through the part; "
+            "refine the mesh where it wears or shorten the run (or, where a single step "
+            "wears about as deep as the edges, lower the wear coefficient or run.dt)")
 
 
 def run_scene(scene, observers=(), check_dt=True):

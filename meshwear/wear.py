@@ -49,7 +49,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import jumps
+from . import jump_geometry, jumps
 from .kernels.contact import ANCHOR
 from .kernels.counter_wear import SPACING_FRACTION
 from .kernels.nearest import face_frames
@@ -318,10 +318,17 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                 return _keep_volume(model.bodies, measures, rates, state.bodies, before,
                                     results, jump, window, js.volumes, forced)
 
+            reaches = [jump_geometry.reach(model, body, s, state.time)
+                       for body, s in zip(model.bodies, state.bodies)]
+
+            def fits(results):
+                return jump_geometry.cut(model, state.bodies, before, rates, results, measures,
+                                         window, reaches)
+
             jump, which, results = _choose_implicit(
                 measures, rates, js, end_limit, int(min(could, part_limit)), tolerance,
                 forced_jump, middle, [float(s.wear_depth.max(initial=0.0)) for s in state.bodies],
-                keep)
+                keep, fits)
             if part_limit < could and (which == "growth" or part_limit < 1):
                 which = part_which       # the counter-parts bounded it (or refused it)
         else:
@@ -335,6 +342,13 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                     if j < jump:
                         jump, which = j, w
             jump = min(jump, could)
+            if forced_jump is None and jump > 0:
+                # fold: the extrapolated moves are the cycle's times the
+                # jump, so the share of one cycle allowed is the cycles
+                cycle = [(rate, 0.0, None) for rate in rates]
+                cut = jump_geometry.cut(model, state.bodies, before, rates, cycle, None, window)
+                if cut is not None and cut[1] < jump:
+                    which, jump = cut[0], int(np.floor(cut[1]))
             results = [(jump * rate, 0.0, _slope_error(rate, previous, js.gap, jump))
                        for rate, previous in zip(rates, js.rate)]
         if jump > 0:
@@ -439,7 +453,7 @@ def _slope_error(rate, previous, gap, jump):
 
 
 def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=0.0,
-                     deepest=None, keep=None):
+                     deepest=None, keep=None, fits=None):
     """Cycles to jump over with implicit jumps, which bound set it, and per
     body the jump's ``(wear, move, step-doubling error estimate)``.
 
@@ -452,9 +466,12 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=
     (:func:`_after`), of the body's ``deepest`` wear after the jump; its
     noise about that drift, random from jump to jump, relaxed alike, within
     the latter; step doubling (the jump's estimated error ``<= tol J
-    r_max``); and ``keep(results, jump)``, which returns the jump's results
+    r_max``); ``keep(results, jump)``, which returns the jump's results
     with the volume kept (:func:`_keep_volume`) or None where the jump is
-    too long. ``t``: the middle of this measurement (cycles). The jump taken
+    too long; and ``fits(results)``, the mesh the jump moves
+    (:func:`meshwear.jump_geometry.cut`: None, or the bound the results
+    break and the share of the jump it allows). ``t``: the middle of this
+    measurement (cycles). The jump taken
     adds its errors to ``js.error`` (step doubling's), ``js.drift``,
     ``js.noise_var`` and ``js.bias`` (the common part)."""
     fastest = max(float(r.max()) if len(r) else 0.0 for r in rates)
@@ -499,7 +516,7 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=
     jump = int(np.floor(bounds[which]))
     for _ in range(40):
         if jump < 1:
-            return 0, which if which in ("noise", "drift", "volume") else "accuracy", None
+            return 0, which if which in REFUSING else "accuracy", None
         results = [jumps.implicit(m, jump) for m in measures]
         worst = max(float(e.max(initial=0.0)) for _, _, e in results) / (tolerance * jump
                                                                           * fastest)
@@ -517,12 +534,25 @@ def _choose_implicit(measures, rates, js, end, could, tolerance, forced=None, t=
                 # penetration to hold (:func:`_keep_volume`)
                 jump, which = jump // 2, "volume"
                 continue
+        cut = fits(spread) if fits is not None else None
+        if cut is not None:
+            # the moves the jump gives the mesh, at most linear in its
+            # cycles (the implicit step relieves them as it grows), bring
+            # the jump to about the cycles allowed, a little under them
+            which, allowed = cut
+            jump = int(min(0.9 * jump, 0.95 * allowed * jump))
+            continue
         for k, (m, (drift, noise), (_, _, e)) in enumerate(zip(measures, trends, results)):
             doubling, drifted, variance, common = _after(js, k, m, drift, noise, jump, e)
             js.error[k][m.index], js.drift[k][m.index] = doubling, drifted
             js.noise_var[k][m.index], js.bias[k] = variance, common
         return jump, which, spread
-    return 0, which if which == "volume" else "accuracy", None
+    return 0, which if which in REFUSING else "accuracy", None
+
+
+#: the bounds that, refusing even one cycle, name the refusal (the others
+#: call it accuracy)
+REFUSING = ("noise", "drift", "volume", "reach", "fold")
 
 
 #: the most a load-carrying body's implicit jump may be off the volume its
@@ -812,21 +842,23 @@ def _jump(model, state, before, rates, jump, results, measures=None, window=1):
             normal = np.zeros((len(rate), 3))
             normal[measures[k].index] = measures[k].normal
         # every increment of the cycle scaled like the vertex's wear: a
-        # vertex relieved by the jump wears, and dissipates, less
+        # vertex relieved by the jump wears, and dissipates, less; a vertex
+        # the jump brought into contact had no cycle to scale: it moves
+        # along its surface's normal (jump_geometry.displacement, which
+        # the jump's bounds read)
         factor = np.full(len(rate), float(jump))
         wearing = rate > 0.0
         factor[wearing] = wear[wearing] / rate[wearing]
         factor /= window                 # the increments are the window's
         work = s.friction_work - work0
         volume = s.wear_volume - volume0
-        s.vertices += factor[:, None] * (s.vertices - vertices0)
+        s.vertices += jump_geometry.displacement(body, s, vertices0, rate, wear, normal, window)
         s.wear_volume += factor * volume
         s.friction_work += factor * work
         fresh = ~wearing & (wear > 0.0)
         if fresh.any() and normal is not None:
-            # a vertex the jump brought into contact had no cycle to scale:
-            # it moves along its surface's normal, wears its depth times its
-            # contact area, and dissipates what the contact does per volume
+            # and wears its depth times its contact area, and dissipates
+            # what the contact does per volume
             _wear_fresh(body, s, fresh, wear, normal,
                         work[wearing].sum() / max(volume[wearing].sum(), 1e-300))
         s.wear_depth += wear
@@ -1066,12 +1098,10 @@ def _fresh_area(body, s, fresh, normal):
 
 
 def _wear_fresh(body, s, fresh, wear, normal, work_per_volume):
-    """Wear ``wear[fresh]`` of vertices with no cycle increments to scale,
-    pressed by the surfaces of world ``normal`` (n, 3)."""
-    local = normal[fresh] @ quaternion_matrix(s.pose[3:7])   # the normal in the body frame
-    direction = body.wear_direction[fresh] if len(body.wear_direction) else local
+    """The worn volume and friction work of the wear ``wear[fresh]`` of
+    vertices with no cycle increments to scale, pressed by the surfaces of
+    world ``normal`` (n, 3) (their move is :func:`meshwear.jump_geometry.displacement`'s)."""
     depth = wear[fresh]
-    s.vertices[fresh] += depth[:, None] * direction
     volume = depth * _fresh_area(body, s, fresh, normal)
     s.wear_volume[fresh] += volume
     s.friction_work[fresh] += work_per_volume * volume
