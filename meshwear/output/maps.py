@@ -61,6 +61,18 @@ UNROLLED_WIDTH, UNROLLED_ROW_HEIGHT, UNROLLED_DPI = 12.0, 1.6, 110
 UNROLLED_MARGINS = (0.5, 0.6)
 
 
+def pyplot():
+    """matplotlib.pyplot on the Agg backend (ExportError naming the extra if it is missing)."""
+    try:
+        import matplotlib
+    except ImportError:
+        raise ExportError("meshwear plot needs matplotlib: pip install 'meshwear[plots]'") from None
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
 def mesh_fields(out_dir, name, frame=-1):
     """A part's mesh in its own frame at ``frame``, its wear depth there and the frame's time."""
     vertices, faces, time = part_mesh(out_dir, name, frame)
@@ -372,9 +384,7 @@ def unrolled_map(vertices, faces, depth, axis, title, path):
     by matplotlib to ``path``, wear depth (µm) against the arc length round
     the axis and the position along it (mm), in rows when the strip is long
     (:data:`ROW_ASPECT`); returns each vertex's (row, column) there."""
-    from .plots import _pyplot
-
-    plt = _pyplot()
+    plt = pyplot()
     import matplotlib
     import matplotlib.image
 

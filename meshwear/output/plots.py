@@ -10,21 +10,10 @@ from pathlib import Path
 import numpy as np
 
 from .export import SERIES_SUFFIXES, ExportError, chosen_parts, part_mesh
-from .maps import mesh_fields, wear_map
+from .maps import mesh_fields, pyplot, wear_map
 
 #: samples along a profile line
 PROFILE_SAMPLES = 400
-
-
-def _pyplot():
-    try:
-        import matplotlib
-    except ImportError:
-        raise ExportError("meshwear plot needs matplotlib: pip install 'meshwear[plots]'") from None
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def plot(out_dir, names=None, dest=None, profile=None, view=None):
@@ -43,7 +32,7 @@ def plot(out_dir, names=None, dest=None, profile=None, view=None):
         Direction the wear maps look from, in the part's own frame
         (default: :func:`meshwear.output.maps.wear_map`'s choice).
     """
-    plt = _pyplot()
+    plt = pyplot()
     out_dir = Path(out_dir)
     if not out_dir.is_dir():
         raise ExportError(f"{out_dir}: no such output folder")
