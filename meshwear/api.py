@@ -276,12 +276,16 @@ class HistoryColumns:
         pass
 
     def table(self):
-        """One array per column (``body`` an object array of names)."""
+        """One array per column (``body`` an object array of names), in the
+        order of ``history.csv``: a mechanism's joint and actuator columns
+        last."""
         from .output.recorder import EXTRA_COLUMNS
         from .output.tables import HISTORY_COLUMNS
 
         out = {}
-        for column in HISTORY_COLUMNS + EXTRA_COLUMNS:
+        fixed = tuple(HISTORY_COLUMNS) + tuple(EXTRA_COLUMNS)
+        for column in fixed + tuple(c for c in (self.rows[0] if self.rows else ())
+                                    if c not in fixed):
             values = [row[column] for row in self.rows]
             out[column] = np.array(values, dtype=object if column == "body" else
                                    int if column in INTEGER_COLUMNS else float)

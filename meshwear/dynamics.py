@@ -27,6 +27,11 @@ The interface (a new engine is one more class):
     At the start of a run, and after a cycle jump moved the clock on.
 ``get_state()``, ``set_state(values, model, state)``
     Its own state for checkpoints (None: it has none beyond the parts').
+``show(model, state, values=None)``
+    Outputs filled from a jump (:mod:`meshwear.output.filled`) are written
+    from ``state`` with its parts, their surfaces and its columns at the
+    phase its state ``values`` (a ``get_state()``) was taken at; None: back
+    to its own state, untouched by the showing.
 ``columns()``, ``describe(model, state)``, ``stable_limit(bodies, law, slots)``
     Its ``history.csv`` columns now, its lines in ``meshwear check`` (the run
     about to start from ``state``), and the
@@ -78,6 +83,9 @@ class OwnMotions:
         return None
 
     def set_state(self, values, model, state):
+        pass
+
+    def show(self, model, state, values=None):
         pass
 
     def columns(self):

@@ -152,6 +152,8 @@ class Mechanism:
         #: message of a run.dt above it that the active sets no longer hold
         #: (:meth:`watch`), and whether a refresh is to be checked
         self.strict, self.failed, self.due = np.inf, None, False
+        #: the data of a phase outputs filled from a jump show (:meth:`show`)
+        self.shown, self._phase = None, None
 
     # ------------------------------------------------------------ set-up
     def _check_geom(self, scene, key, name, body, path):
@@ -403,7 +405,7 @@ class Mechanism:
 
     # ------------------------------------------------------------ coupling
     def _arrays(self):
-        d = self.data
+        d = self.data if self.shown is None else self.shown
         return d.xpos, d.xquat, d.xmat, d.cvel, d.subtree_com, self.model.body_rootid
 
     def body_pose(self, name, placement, out=None):
@@ -558,6 +560,24 @@ class Mechanism:
         self.data.time += duration
         self.place(model, state, state.time)
 
+    def show(self, model, state, values=None):
+        """For outputs filled from a jump (:mod:`meshwear.output.filled`):
+        the riders of ``state``, the surfaces on its bodies and the joint
+        columns where MuJoCo had them at the phase of ``values`` (a
+        :meth:`get_state`), placed at ``state.time``; None: back where its
+        own data has them. Its own data is left alone (:meth:`set_state`'s
+        forward pass would change the next step's warm start)."""
+        mujoco, m = self.mujoco, self.model
+        self.shown = None
+        if values is not None:
+            if self._phase is None:
+                self._phase = mujoco.MjData(m)
+            mujoco.mj_setState(m, self._phase, np.asarray(values, float),
+                               mujoco.mjtState.mjSTATE_INTEGRATION)
+            mujoco.mj_forward(m, self._phase)
+            self.shown = self._phase
+        self.place(model, state, state.time)
+
     # ------------------------------------------------------------ state
     def _start(self):
         mujoco, m, d = self.mujoco, self.model, self.data
@@ -603,7 +623,7 @@ class Mechanism:
         slide joint's position and velocity (``<joint>.q``, ``<joint>.v``)
         and each actuator's force (``<actuator>.force``); ball and free
         joints are in the rows of the parts they carry."""
-        m, d = self.model, self.data
+        m, d = self.model, self.data if self.shown is None else self.shown
         out = {}
         kinds = (int(self.mujoco.mjtJoint.mjJNT_HINGE), int(self.mujoco.mjtJoint.mjJNT_SLIDE))
         for j in range(m.njnt):

@@ -8,9 +8,11 @@ body is recorded at the phases of the outputs the jump may cover
 work and the worn vertices interpolated along the jump, the pose and the
 contact those of the resolved cycle at the same phase (the pose put on its
 path at the output's time, a guided body moved along its axis by the jump's
-share; the forces, planes and faces of the touching vertices, so a worn
-counter-part's reaction is the bodies' at that phase too). The rows and
-frames are marked ``resolved = 0``.
+share; the forces, planes and faces of the touching vertices and the
+vertices within reach of a surface, so a worn counter-part's reaction is the
+bodies' at that phase too; a mechanism's state, so the parts it carries, its
+worn counter-surfaces' frames and its joint columns are those of that phase
+too). The rows and frames are marked ``resolved = 0``.
 """
 
 import copy
@@ -26,8 +28,8 @@ class Snapshot:
     """One body's state at one phase of the resolved cycle: pose, contact
     wrench, contact states, and the contact of its vertices that touch (their
     indices, forces, the planes and faces of the per-vertex surfaces under
-    them): what the body's and the worn counter-parts' fields and reactions
-    are made of."""
+    them, and the vertices within reach of a surface then): what the body's
+    and the worn counter-parts' fields and reactions are made of."""
 
     pose: np.ndarray
     wrench: np.ndarray
@@ -37,17 +39,30 @@ class Snapshot:
     friction_force: np.ndarray
     planes: np.ndarray
     hint: np.ndarray
+    active: np.ndarray
 
 
-def _capture(state):
+@dataclass
+class Phase:
+    """The state at one phase of the resolved cycle: a :class:`Snapshot` per
+    body and the dynamics' own state (``model.dynamics.get_state()``: a
+    mechanism's; None for meshwear's own motions)."""
+
+    bodies: list
+    dynamics: np.ndarray = None
+
+
+def _capture(model, state):
     out = []
     for s in state.bodies:
         touching = np.flatnonzero((s.normal_force > 0.0).any(axis=0))
         out.append(Snapshot(s.pose.copy(), s.wrench.copy(), s.contact_state.copy(), touching,
                             s.normal_force[:, touching].copy(),
                             s.tangential[:, touching, FORCE].copy(),
-                            s.vertex_planes[:, touching].copy(), s.hint[:, touching].copy()))
-    return out
+                            s.vertex_planes[:, touching].copy(), s.hint[:, touching].copy(),
+                            s.active.copy()))
+    dynamics = model.dynamics.get_state()
+    return Phase(out, None if dynamics is None else np.array(dynamics, copy=True))
 
 
 def phases(model, start, stop, cycles):
@@ -70,7 +85,7 @@ def record(model, state, start, stop, cycles, observers, progress, advance):
     for r in sorted(wanted) + [stop]:
         advance(model, state, r, observers, progress)
         if r in wanted:
-            snapshots[r - start] = _capture(state)
+            snapshots[r - start] = _capture(model, state)
     return snapshots
 
 
@@ -91,31 +106,46 @@ def write(model, state, stop, jump, snapshots, spans, observers, check, part_spa
     schedule = model.output_steps
     start = stop - n_c
     inside = schedule[(schedule > stop) & (schedule < end)].tolist()
-    for o in inside:
-        phase = (o - start) % n_c
-        shots = snapshots[phase if phase else n_c]
-        fraction = (o - stop) / (end - stop)
-        shares = (progress(fraction) if progress is not None
-                  else [(fraction, fraction)] * len(spans))
-        view = copy.copy(state)
-        view.step, view.time = o, o * model.dt
-        view.bodies = [_view(body, s, shot, span, share, view.time)
-                       for body, s, shot, span, share in zip(model.bodies, state.bodies, shots,
-                                                             spans, shares)]
-        if part_spans:
-            spans_left = iter(part_spans)
-            view.parts = [None if p is None else _interpolated(p, next(spans_left), fraction)
-                          for p in state.parts]
-        sample, frame = o in model.sample_set, o in model.frame_set
-        if frame:
-            check(model, view, [b.reference_face_normals for b in model.bodies])
-        for observer in observers:
-            if sample:
-                observer.on_sample(model, view)
-            if frame:
-                observer.on_frame(model, view)
-        state.written = o
+    try:
+        for o in inside:
+            _write_one(model, state, o, start, end, snapshots, spans, observers, check,
+                       part_spans, progress)
+    finally:
+        # (a mechanism shown at the outputs' phases: back where the jump left it)
+        model.dynamics.show(model, state)
     return len(inside)
+
+
+def _write_one(model, state, o, start, end, snapshots, spans, observers, check, part_spans,
+               progress):
+    """:func:`write`'s output at step ``o``."""
+    n_c, stop = model.cycle_steps, start + model.cycle_steps
+    phase = (o - start) % n_c
+    shot = snapshots[phase if phase else n_c]
+    fraction = (o - stop) / (end - stop)
+    shares = (progress(fraction) if progress is not None
+              else [(fraction, fraction)] * len(spans))
+    view = copy.copy(state)
+    view.step, view.time = o, o * model.dt
+    view.bodies = [_view(body, s, one, span, share, view.time)
+                   for body, s, one, span, share in zip(model.bodies, state.bodies, shot.bodies,
+                                                        spans, shares)]
+    if part_spans:
+        spans_left = iter(part_spans)
+        view.parts = [None if p is None else _interpolated(p, next(spans_left), fraction)
+                      for p in state.parts]
+    # (a mechanism's riders and the surfaces on its bodies where it had
+    # them at that phase, at the output's time)
+    model.dynamics.show(model, view, shot.dynamics)
+    sample, frame = o in model.sample_set, o in model.frame_set
+    if frame:
+        check(model, view, [b.reference_face_normals for b in model.bodies])
+    for observer in observers:
+        if sample:
+            observer.on_sample(model, view)
+        if frame:
+            observer.on_frame(model, view)
+    state.written = o
 
 
 def _interpolated(part, span, fraction):
@@ -150,4 +180,9 @@ def _view(body, s, shot, span, share, t):
     view.vertex_planes[:, touching] = shot.planes
     view.hint = np.full_like(s.hint, -1)
     view.hint[:, touching] = shot.hint
+    # the vertices within reach at that phase: a worn counter-part's reaction
+    # is summed over them (meshwear.output.fields.part_quantities), and the
+    # contact moves over a turning part (a gear's teeth), so those at the
+    # cycle's end miss most of the phase's touching vertices
+    view.active = shot.active
     return view

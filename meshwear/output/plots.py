@@ -1,36 +1,19 @@
 """Pictures of a run's folder (``meshwear plot``, docs/outputs.md): a wear map
-of each worn part, wear profiles along a line, and the force and wear-volume
-histories, as PNG files (and the profiles as CSV).
-
-The wear map is drawn by pyvista off screen, the part in its own frame
-(:mod:`meshwear.output.export`) seen from outside its worn face; the curves
-by matplotlib (the ``plots`` extra).
+of each worn part (:mod:`meshwear.output.maps`), wear profiles along a line,
+and the force and wear-volume histories, as PNG files (and the profiles as
+CSV). The curves are drawn by matplotlib (the ``plots`` extra).
 """
 
 import csv
-import os
 from pathlib import Path
 
 import numpy as np
 
-from .export import (SERIES_SUFFIXES, ExportError, chosen_parts, part_mesh, read_frame,
-                     series_frames)
+from .export import SERIES_SUFFIXES, ExportError, chosen_parts, part_mesh
+from .maps import mesh_fields, pyplot, wear_map
 
-#: pixels of the wear maps
-MAP_SIZE = (900, 700)
 #: samples along a profile line
 PROFILE_SAMPLES = 400
-
-
-def _pyplot():
-    try:
-        import matplotlib
-    except ImportError:
-        raise ExportError("meshwear plot needs matplotlib: pip install 'meshwear[plots]'") from None
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def plot(out_dir, names=None, dest=None, profile=None, view=None):
@@ -47,9 +30,9 @@ def plot(out_dir, names=None, dest=None, profile=None, view=None):
         under it is written as ``<part>_profile.png`` and ``.csv``.
     view : (3,), optional
         Direction the wear maps look from, in the part's own frame
-        (default: :func:`map_view`).
+        (default: :func:`meshwear.output.maps.wear_map`'s choice).
     """
-    plt = _pyplot()
+    plt = pyplot()
     out_dir = Path(out_dir)
     if not out_dir.is_dir():
         raise ExportError(f"{out_dir}: no such output folder")
@@ -80,76 +63,6 @@ def plot(out_dir, names=None, dest=None, profile=None, view=None):
     return written
 
 
-def _mesh_fields(out_dir, name, frame=-1):
-    vertices, faces, time = part_mesh(out_dir, name, frame)
-    depth = np.asarray(read_frame(series_frames(out_dir, name)[frame][1])
-                       .point_data["wear_depth"], float)
-    return vertices, faces, depth, time
-
-
-#: the worn faces face one way when the wear-weighted mean of their normals
-#: is at least this fraction of the weights (a pin, a block); else they face
-#: round an axis (a gear's flanks, a bore) and the map looks along it
-ONE_WAY = 0.3
-
-
-def map_view(normals, depth):
-    """(3,) unit direction a wear map looks from: the wear-weighted mean of the
-    outward ``normals`` of the vertices (worn by ``depth``) where the worn faces
-    face one way (:data:`ONE_WAY`); else the axis they face round (the
-    direction least along them: the weighted normals' smallest principal
-    axis), from its positive side."""
-    weights = depth / depth.max() if depth.max() > 0.0 else np.ones(len(depth))
-    mean = (weights[:, None] * normals).sum(axis=0)
-    if np.linalg.norm(mean) >= ONE_WAY * weights.sum() and np.linalg.norm(mean) > 0.0:
-        return mean / np.linalg.norm(mean)
-    spread = np.einsum("i,ij,ik->jk", weights, normals, normals)
-    axis = np.linalg.eigh(spread)[1][:, 0]
-    return axis if axis[np.argmax(np.abs(axis))] > 0.0 else -axis
-
-
-def wear_map(out_dir, name, path, view=None):
-    """The part at its last frame coloured by wear depth (µm), seen from
-    ``view`` (its own frame) or from :func:`map_view`, with a scale bar."""
-    if "DISPLAY" not in os.environ and "VTK_DEFAULT_OPENGL_WINDOW" not in os.environ:
-        # no X server: render through EGL (VTK's default would try X first
-        # and print a warning)
-        os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkEGLRenderWindow"
-    import pyvista
-
-    vertices, faces, depth, time = _mesh_fields(out_dir, name)
-    mesh = pyvista.PolyData(vertices, np.hstack([np.full((len(faces), 1), 3), faces]).ravel())
-    mesh.point_data["wear depth (µm)"] = depth * 1e6
-    normals = mesh.compute_normals(point_normals=True, cell_normals=False,
-                                   auto_orient_normals=False).point_data["Normals"]
-    view = (np.asarray(view, float) if view is not None
-            else map_view(np.asarray(normals, float), depth))
-    view = view / np.linalg.norm(view)
-    up = np.cross(view, [0.0, 0.0, 1.0] if abs(view[2]) < 0.9 else [1.0, 0.0, 0.0])
-    up = np.cross(up, view)
-    try:
-        plotter = pyvista.Plotter(off_screen=True, window_size=MAP_SIZE)
-    except Exception as err:  # no OpenGL at all (a bare container)
-        raise ExportError(f"meshwear plot: cannot render off screen ({err}); install EGL or "
-                          "OSMesa, or run with a display") from None
-    plotter.set_background("white")
-    plotter.add_mesh(mesh, scalars="wear depth (µm)", cmap="viridis", show_edges=False,
-                     scalar_bar_args={"title": "wear depth (µm)\n", "color": "black",
-                                      "vertical": True, "fmt": "%.3g", "position_x": 0.8,
-                                      "position_y": 0.1, "width": 0.07, "height": 0.75,
-                                      "title_font_size": 14, "label_font_size": 12})
-    plotter.add_text(f"{name}, t = {time:.6g} s, deepest {depth.max() * 1e6:.3g} µm",
-                     font_size=10, color="black")
-    center = np.asarray(mesh.center)
-    distance = 3.0 * max(mesh.length, 1e-12)
-    plotter.camera_position = [tuple(center + distance * view), tuple(center), tuple(up)]
-    plotter.reset_camera()
-    plotter.camera.zoom(0.8)                # clear of the scale bar
-    plotter.screenshot(str(path))
-    plotter.close()
-    return path
-
-
 def wear_profile(out_dir, name, line, stem, plt):
     """Wear depth at the end under the line ``line`` = (start, end) in the
     part's own frame (m): each sample's nearest point on the unworn part
@@ -159,7 +72,7 @@ def wear_profile(out_dir, name, line, stem, plt):
 
     start, end = _line(line)
     unworn, faces, _ = part_mesh(out_dir, name, 0)
-    *_, depth, time = _mesh_fields(out_dir, name)
+    *_, depth, time = mesh_fields(out_dir, name)
     s = np.linspace(0.0, 1.0, PROFILE_SAMPLES)
     samples = start + s[:, None] * (end - start)
     triangles = unworn[faces]
