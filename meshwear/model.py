@@ -247,6 +247,12 @@ class PartState:
         (0,): not kept).
     place : (V,) int64
         Where each lagging vertex is in ``touched``, -1 for the others.
+    pending, pending_list, pending_place, pending_count : (3, V) float, (V,) int64, (V,) int64, (1,) int64
+        What waits on each vertex to be spread over its neighbours (volume,
+        energy, least penetration), the vertices with some, each one's place
+        among them and their count (a spreading part:
+        :func:`meshwear.kernels.counter_wear.wear_counter`); nothing waits
+        between two stretches of steps.
     """
 
     vertices: np.ndarray
@@ -261,6 +267,10 @@ class PartState:
     count: np.ndarray
     stiffness: np.ndarray = field(default_factory=lambda: np.zeros(0))
     place: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    pending: np.ndarray = field(default_factory=lambda: np.zeros((3, 0)))
+    pending_list: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    pending_place: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    pending_count: np.ndarray = field(default_factory=lambda: np.zeros(1, np.int64))
 
     @classmethod
     def unworn(cls, surface, stiffness=False):
@@ -271,7 +281,9 @@ class PartState:
                    depth=np.zeros(n), volume=np.zeros(n), work=np.zeros(n), added=np.zeros(n),
                    touched=np.zeros(n, np.int64), limit=np.full(n, np.inf),
                    due=np.zeros(n, np.int64), count=np.zeros(1, np.int64),
-                   stiffness=np.zeros(n if stiffness else 0), place=np.full(n, -1, np.int64))
+                   stiffness=np.zeros(n if stiffness else 0), place=np.full(n, -1, np.int64),
+                   pending=np.zeros((3, n)), pending_list=np.zeros(n, np.int64),
+                   pending_place=np.full(n, -1, np.int64), pending_count=np.zeros(1, np.int64))
 
 
 @dataclass(eq=False)
@@ -342,6 +354,10 @@ def build_model(scene):
                                  "only; set wear.jump = 'implicit' (the default)")
             surface.make_worn(code_of(s.law or scene.wear.law),
                               scene.wear.coefficient if s.coefficient is None else s.coefficient)
+            # a contact wears the area its body vertex stands for
+            surface.spread_over(SPREAD * max((contact_spacing(b, sb)
+                                              for b, sb in zip(bodies, scene.bodies)),
+                                             default=0.0))
     if mechanism is not None:
         # refined or made worn: the riders anew
         mechanism.surfaces = []
@@ -645,6 +661,29 @@ def _build_body(scene, index, body, surface_set, mechanism=None):
         depth_limit=(IMPACT_DEPTH * _thinnest(body_vertices)
                      if motion.dynamic_axes is not None and not riding else 0.0),
         refinement=refinement)
+
+
+#: a worn counter-part spreads a contact's wear over this many times the
+#: spacing of the bodies' vertices that meet it (docs/model.md, "Worn
+#: counter-surfaces")
+SPREAD = 2.5
+
+
+def contact_spacing(body, scene_body):
+    """The spacing (m) of the vertices of ``body`` (a :class:`BodyModel`)
+    where it meets counter-parts: the median of their shortest edges, over
+    the vertices its ``resolution`` refined (those whose shortest edge is
+    within it) if it has one, else over all."""
+    faces, vertices = body.faces, body.reference_vertices
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    lengths = np.linalg.norm(vertices[edges[:, 0]] - vertices[edges[:, 1]], axis=1)
+    shortest = np.full(len(vertices), np.inf)
+    np.minimum.at(shortest, edges.ravel(), np.repeat(lengths, 2))
+    shortest = shortest[np.isfinite(shortest)]
+    resolution = getattr(scene_body, "resolution", None)
+    if resolution is not None and (shortest <= resolution).any():
+        shortest = shortest[shortest <= resolution]
+    return float(np.median(shortest)) if len(shortest) else 0.0
 
 
 #: a vertex in contact deeper than this fraction of its body's thinnest

@@ -16,6 +16,9 @@ NO_CONTACT, STICK, SLIP = 0, 1, 2
 #: a worn counter vertex moves once its lag reaches this fraction of the
 #: smallest penetration of the pairs that wore it since (docs/model.md)
 LAG_FRACTION = 1e-2
+#: a spreading counter vertex spreads what waits on it once its depth there
+#: reaches this fraction of its lag limit
+PENDING_FRACTION = 0.5
 #: law code -> numpy twin of its increment (the twins live beside the
 #: increments in the registry; the kernel's dispatch on codes is what this
 #: checks)
@@ -467,7 +470,7 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
     of them). ``log``: (index, value, count) as the kernel's log (logged
     while ``count[1]`` is 1)."""
     (counter_law, faces, reference, normals, tributary, spacing, _, _, vertices, frames, depth,
-     volume, work, added, _, limit, _, _, stiffness, _) = part
+     volume, work, added, _, limit, _, _, stiffness, _, spread) = part
     code, k = int(counter_law[0]), counter_law[1]
     f, dt, dt0, dt1 = law[0], law[4], law[11], law[12]
     R = quaternion_matrix(pose[3:7])
@@ -503,20 +506,23 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
                         value[row] = weights[p, c] * load[p]
                     count[0] = row + 1
     before = depth.copy()
-    for c in range(3):
-        np.add.at(work, corners[:, c], weights[:, c] * energy)
-        np.add.at(volume, corners[:, c], weights[:, c] * dv)
-        np.add.at(depth, corners[:, c], weights[:, c] * dv / tributary[corners[:, c]])
-        # a vertex moves once its lag reaches LAG_FRACTION of the smallest
-        # penetration of the pairs that wore it since it last moved
-        wore = (weights[:, c] > 0.0) & (dv > 0.0)
-        np.minimum.at(limit, corners[wore, c],
-                      LAG_FRACTION * np.minimum(-delta[wore], spacing[corners[wore, c]]))
-        # how much its wear falls per unit of its own depth: w^2 dV / (delta A)
-        pressed = wore & (delta < 0.0)
-        if len(stiffness):
-            np.add.at(stiffness, corners[pressed, c], weights[pressed, c] ** 2 * dv[pressed]
-                      / (-delta[pressed] * tributary[corners[pressed, c]]))
+    if len(spread[0]):
+        _spread_pairs(energy, dv, delta, corners, weights, part)
+    else:
+        for c in range(3):
+            np.add.at(work, corners[:, c], weights[:, c] * energy)
+            np.add.at(volume, corners[:, c], weights[:, c] * dv)
+            np.add.at(depth, corners[:, c], weights[:, c] * dv / tributary[corners[:, c]])
+            # a vertex moves once its lag reaches LAG_FRACTION of the smallest
+            # penetration of the pairs that wore it since it last moved
+            wore = (weights[:, c] > 0.0) & (dv > 0.0)
+            np.minimum.at(limit, corners[wore, c],
+                          LAG_FRACTION * np.minimum(-delta[wore], spacing[corners[wore, c]]))
+            # how much its wear falls per unit of its own depth: w^2 dV / (delta A)
+            pressed = wore & (delta < 0.0)
+            if len(stiffness):
+                np.add.at(stiffness, corners[pressed, c], weights[pressed, c] ** 2 * dv[pressed]
+                          / (-delta[pressed] * tributary[corners[pressed, c]]))
     added += depth - before
     deep = np.flatnonzero(added > 0.5 * spacing)
     moved = (added > 0.0) & (added >= limit)
@@ -527,10 +533,60 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
     return deep
 
 
+def _spread_pairs(energy, dv, delta, corners, weights, part):
+    """A spreading part's pairs, one after the other (:func:`wear_counter`):
+    each corner's share waits there, and spreads over its neighbours once
+    its depth there reaches PENDING_FRACTION of its lag limit."""
+    tributary, spacing, stiffness, spread = part[4], part[5], part[18], part[20]
+    pending, waiting = spread[4], spread[6]
+    for p in range(len(energy)):
+        if dv[p] <= 0.0 and energy[p] <= 0.0:
+            continue
+        for c in range(3):
+            k, w = corners[p, c], weights[p, c]
+            if w <= 0.0:
+                continue
+            if waiting[k] < 0:
+                waiting[k], pending[2, k] = 1, np.inf
+            pending[1, k] += w * energy[p]
+            if dv[p] <= 0.0:
+                continue
+            pending[0, k] += w * dv[p]
+            pending[2, k] = min(pending[2, k], -delta[p])
+            if len(stiffness) and delta[p] < 0.0:
+                stiffness[k] += w * w * dv[p] * spread[3][k] / (-delta[p] * tributary[k])
+            if pending[0, k] >= (PENDING_FRACTION * LAG_FRACTION * tributary[k]
+                                 * min(pending[2, k], spacing[k])):
+                _spread(k, part)
+
+
+def _spread(k, part):
+    """Twin of :func:`meshwear.kernels.counter_wear._spread` (the pending
+    list's order aside)."""
+    (_, _, _, _, tributary, spacing, _, _, _, _, depth, volume, work, _, _, limit, _, _, _, _,
+     spread) = part
+    starts, items, weights, _, pending, _, waiting, _ = spread
+    j, s = items[starts[k]:starts[k + 1]], weights[starts[k]:starts[k + 1]]
+    volume_k, energy_k, least = pending[:, k]
+    np.add.at(work, j, s * energy_k)
+    if volume_k > 0.0:
+        np.add.at(volume, j, s * volume_k)
+        np.add.at(depth, j, s * volume_k / tributary[j])
+        np.minimum.at(limit, j, LAG_FRACTION * np.minimum(least, spacing[j]))
+    pending[0, k] = pending[1, k] = 0.0
+    pending[2, k] = np.inf
+    waiting[k] = -1
+
+
 def settle_counter(part):
     """Twin of :func:`meshwear.kernels.counter_wear.settle_counter`."""
     (_, faces, reference, normals, _, _, _, _, vertices, frames, depth, _, _, added, _, limit,
-     _, _, _, _) = part
+     _, _, _, _, spread) = part
+    if len(spread[0]):
+        before = depth.copy()
+        for k in np.flatnonzero(spread[6] >= 0):
+            _spread(k, part)
+        added += depth - before
     moved = added > 0.0
     vertices[moved] = reference[moved] - depth[moved, None] * normals[moved]
     added[moved] = 0.0

@@ -60,9 +60,11 @@ P, A, R, OMEGA, K_PIN, K_DISC = 10.0, 1e-3, 5e-3, 10.0, 1e-13, 2e-13
 TWO_TURNS = 4.0 * np.pi / OMEGA
 
 
-def _scene(tmp_path, duration=TWO_TURNS, coefficient=K_DISC, extra="", dt=2e-3):
+def _scene(tmp_path, duration=TWO_TURNS, coefficient=K_DISC, extra="", dt=2e-3,
+           disc_resolution=3e-4):
     path = tmp_path / "pin_on_worn_disc.toml"
-    path.write_text(PIN_ON_WORN_DISC.format(duration=duration, coefficient=coefficient, dt=dt)
+    text = PIN_ON_WORN_DISC.format(duration=duration, coefficient=coefficient, dt=dt)
+    path.write_text(text.replace("resolution = 3e-4", f"resolution = {disc_resolution!r}")
                     + extra)
     return path
 
@@ -73,8 +75,15 @@ def two_turns(tmp_path_factory):
     return model, run(model, initial_state(model))
 
 
-def test_kernel_matches_its_numpy_twin(tmp_path):
-    model = build_model(load_scene(_scene(tmp_path, duration=0.1)))
+@pytest.mark.parametrize("disc_resolution", [3e-4, 6e-5])
+def test_kernel_matches_its_numpy_twin(tmp_path, disc_resolution):
+    """On a disc as coarse as the pin, each pair wears the face under its
+    foot; on a finer one, the spread of each of its corners too."""
+    # (on the fine disc the disc wears faster, so that its vertices lag and
+    # move within a few steps of the twin)
+    model = build_model(load_scene(_scene(
+        tmp_path, duration=0.1, disc_resolution=disc_resolution,
+        coefficient=K_DISC if disc_resolution > 1e-4 else 100 * K_DISC)))
     state = run(model, initial_state(model))
     disc, part, s, body = model.surfaces.per_vertex[0], state.parts[0], state.bodies[0], \
         model.bodies[0]
@@ -88,7 +97,9 @@ def test_kernel_matches_its_numpy_twin(tmp_path):
     twin_tuple = (disc.law, disc.faces, disc.reference_vertices, disc.vertex_normals,
                   disc.tributary, disc.spacing, None, None, twin.vertices, twin.frames,
                   twin.depth, twin.volume, twin.work, twin.added, twin.touched, twin.limit,
-                  twin.due, twin.count, twin.stiffness, twin.place)
+                  twin.due, twin.count, twin.stiffness, twin.place,
+                  (*disc.spread, twin.pending, twin.pending_list, twin.pending_place,
+                   twin.pending_count))
 
     def same():
         for name in ("depth", "volume", "work", "vertices", "added", "limit", "stiffness"):
@@ -145,10 +156,21 @@ def test_kernel_matches_its_numpy_twin(tmp_path):
             break
     assert (part.depth > depth0).sum() > 10
     assert lagged and moved, "the case must have vertices that lag and that move"
-    assert (part.stiffness > 0.0).sum() == (part.depth > depth0).sum()
     settle_counter(disc.part_tuple())
     reference.settle_counter(twin_tuple)
     same()
+    assert part.pending_count[0] == 0 and (part.pending_place == -1).all()
+    # a vertex's stiffness is what its depth does to the pairs pressing on
+    # it: every vertex of a face under a pair has one; a spread wears others
+    # too
+    stiff, worn = part.stiffness > 0.0, part.depth > depth0
+    if disc_resolution > 1e-4:
+        assert not len(disc.spread[0])
+        np.testing.assert_array_equal(stiff, worn)
+    else:
+        assert len(disc.spread[0]) and stiff.sum() > 10 and not (stiff & ~worn).any()
+        assert worn.sum() > 2 * stiff.sum()
+
     assert part.count[0] == 0 and not part.added.any() and np.isinf(part.limit).all()
     assert (part.place == -1).all()
     np.testing.assert_allclose(part.vertices, disc.reference_vertices

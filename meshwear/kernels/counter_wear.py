@@ -6,10 +6,13 @@ touches a worn counter mesh wears it by its law's volume on the counter's
 own coefficient (:mod:`meshwear.kernels.laws`), from the same dissipated
 energy, load and slip distance as the body's wear. The volume goes to the
 three vertices of the face under the contact by the barycentric weights of
-the contact point, becomes depth over each vertex's tributary area, and the
-vertex moves by its depth along its inward normal; the faces around a moved
-vertex get their frames again. So the counter's worn volume is its
-coefficient times the pairs' load times slip (or energy), exactly.
+the contact point and, where the bodies' vertices stand for more area than
+the counter's faces, on from each of them over the counter vertices around
+it (its *spread*: the area the contact stands for, see ``spread`` below);
+it becomes depth over each vertex's tributary area, and the vertex moves by
+its depth along its inward normal; the faces around a moved vertex get their
+frames again. So the counter's worn volume is its coefficient times the
+pairs' load times slip (or energy), exactly.
 
 A vertex moves once the depth it took since it last moved (its lag) reaches
 :data:`LAG_FRACTION` of the smallest penetration of the pairs that wore it
@@ -46,7 +49,24 @@ part : tuple
     penetration, ``A`` the vertex's tributary area), by how much its wear in
     the step falls per unit of its own depth (docs/model.md, "Long
     durations"), then where each vertex is in the lagging list (V,) int64,
-    -1 when it does not lag, so that one that moves leaves it at once.
+    -1 when it does not lag, so that one that moves leaves it at once,
+    and its ``spread``, a tuple: ``starts`` (V + 1,) int64, ``items`` int64
+    and ``weights`` float (vertex ``k``'s share of a contact's wear goes on
+    to vertex ``items[e]`` by ``weights[e]`` for ``e`` in
+    ``starts[k]:starts[k + 1]``; they add up to 1), each vertex's weight on
+    itself (V,), then what waits to be spread: ``pending`` (3, V) (the
+    volume, m³, and energy, J, put on each vertex since it last spread, and
+    the least penetration, m, of the pairs that put it, inf for none), the
+    vertices with some (V,) int64, each one's place among them (V,) int64,
+    -1 for none, and their count (1,) int64; all empty where each vertex
+    keeps its share (:meth:`meshwear.surfaces.MeshSurface.spread_over`).
+
+A spreading part takes each pair's shares of the face's corners as pending
+at those corners and spreads a corner's pending wear over its neighbours
+once its depth there reaches :data:`PENDING_FRACTION` of its lag limit
+(and every pending vertex's in :func:`settle_counter`): a pair's share of a
+corner is a thousandth of a contact's penetration or less, and spreading
+each one at once over its tens of neighbours cost ten times the step.
 """
 
 import numpy as np
@@ -60,14 +80,17 @@ from .nearest import closest_on_triangle
 
 PART_FIELDS = ("law", "faces", "reference", "normals", "tributary", "spacing", "starts", "items",
                "vertices", "frames", "depth", "volume", "work", "added", "touched", "limit",
-               "due", "count", "stiffness", "place")
+               "due", "count", "stiffness", "place", "spread")
 
 #: the part tuple of a surface that does not wear
 NO_PART = (np.array([-1.0, 0.0]), np.zeros((0, 3), np.int64), np.zeros((0, 3)), np.zeros((0, 3)),
            np.zeros(0), np.zeros(0), np.zeros(1, np.int64), np.zeros(0, np.int64),
            np.zeros((0, 3)), np.zeros((0, 4, 4)), np.zeros(0), np.zeros(0), np.zeros(0),
            np.zeros(0), np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.int64),
-           np.zeros(1, np.int64), np.zeros(0), np.zeros(0, np.int64))
+           np.zeros(1, np.int64), np.zeros(0), np.zeros(0, np.int64),
+           (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0),
+            np.zeros((3, 0)), np.zeros(0, np.int64), np.zeros(0, np.int64),
+            np.zeros(1, np.int64)))
 
 #: a counter vertex may sink by at most this fraction of its shortest edge in
 #: one step; deeper, its faces could fold over
@@ -77,6 +100,10 @@ SPACING_FRACTION = 0.5
 #: penetration of the pairs that wore it since it last moved (or of its
 #: shortest edge, if smaller)
 LAG_FRACTION = 1e-2
+
+#: a spreading part's vertex spreads what waits on it once its depth there
+#: reaches this fraction of the lag at which a vertex moves
+PENDING_FRACTION = 0.5
 
 #: active vertices from which the pairs' shares are computed on threads
 PARALLEL_PAIRS = 2048
@@ -211,8 +238,10 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
     normal force times its weight on the counter vertex, N);
     ``log_count[0]`` counts on past the rows (then the log is incomplete)."""
     (counter_law, faces, reference, normals, tributary, spacing, starts, items, vertices, frames,
-     depth, volume, work, added, touched, limit, due, lagging, stiffness, place) = part
+     depth, volume, work, added, touched, limit, due, lagging, stiffness, place, spread) = part
     keep_stiffness = stiffness.shape[0] > 0
+    spreading = spread[0].shape[0] > 0
+    pending, pending_list, pending_place, pending_count = spread[4], spread[5], spread[6], spread[7]
     m = active.shape[0]
     at = np.empty(m, np.int64)
     pairs = np.empty((m, 6))
@@ -222,9 +251,9 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
     else:
         _pairs_serial(body_vertices, pose, active, area, law, contact_state, normal_force,
                       planes, hint, rotation, frame, counter_law, faces, vertices, at, pairs)
-    count = lagging[0]
-    moving = 0
-    deep = False
+    # the lagging vertices' count, the moving ones', and whether one sank too deep
+    count_moving = np.zeros(3, np.int64)
+    count_moving[0] = lagging[0]
     logging = log_count[1] == 1
     rows = log_index.shape[0]
     for slot in range(m):
@@ -234,42 +263,42 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
         weights = (pairs[slot, 0], pairs[slot, 1], pairs[slot, 2])
         energy, dv, delta = pairs[slot, 3], pairs[slot, 4], pairs[slot, 5]
         for corner in range(3):
-            j = faces[face, corner]
-            share = weights[corner]
-            if share <= 0.0:
+            k = faces[face, corner]
+            weight = weights[corner]
+            if weight <= 0.0:
                 continue
             if logging:
                 row = log_count[0]
                 if row < rows:
                     log_index[row, 0] = surface
                     log_index[row, 1] = active[slot]
-                    log_index[row, 2] = j
-                    log_value[row] = share * normal_force[active[slot]]
+                    log_index[row, 2] = k
+                    log_value[row] = weight * normal_force[active[slot]]
                 log_count[0] = row + 1
-            work[j] += share * energy
-            if dv > 0.0:
-                volume[j] += share * dv
-                sink = share * dv / tributary[j]
-                depth[j] += sink
-                if place[j] < 0:
-                    # it starts lagging
-                    place[j] = count
-                    touched[count] = j
-                    count += 1
-                added[j] += sink
-                # (-delta: the pair's penetration; none, and it moves now)
-                lag = LAG_FRACTION * min(-delta, spacing[j])
-                if lag < limit[j]:
-                    limit[j] = lag
-                if added[j] >= limit[j] and limit[j] > -np.inf:
-                    # its lag reached its limit: it moves after the step
-                    # (limit -inf marks it for _refit)
-                    due[moving] = j
-                    moving += 1
-                    limit[j] = -np.inf
-                deep = deep or added[j] > SPACING_FRACTION * spacing[j]
-                if keep_stiffness and delta < 0.0:
-                    stiffness[j] -= share * sink / delta
+            if not spreading:
+                _deposit(k, weight, energy, dv, delta, face, faces, weights, tributary, spacing,
+                         depth, volume, work, added, touched, limit, due, stiffness, place,
+                         keep_stiffness, count_moving)
+                continue
+            # it waits at the corner, and spreads once deep enough there
+            if pending_place[k] < 0:
+                pending_place[k] = pending_count[0]
+                pending_list[pending_count[0]] = k
+                pending_count[0] += 1
+                pending[2, k] = np.inf
+            pending[1, k] += weight * energy
+            if dv <= 0.0:
+                continue
+            pending[0, k] += weight * dv
+            if -delta < pending[2, k]:
+                pending[2, k] = -delta
+            if keep_stiffness and delta < 0.0:
+                # (what it keeps of its own share: its weight on itself)
+                stiffness[k] -= weight * weight * dv * spread[3][k] / (delta * tributary[k])
+            if (pending[0, k] >= PENDING_FRACTION * LAG_FRACTION * tributary[k]
+                    * min(pending[2, k], spacing[k])):
+                _spread(k, part, count_moving)
+    count, moving, deep = count_moving[0], count_moving[1], count_moving[2] > 0
     worst = -1
     if deep:
         for c in range(count):
@@ -292,10 +321,93 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
     return worst
 
 
+@njit(cache=True, inline="always")
+def _deposit(j, share, energy, dv, delta, face, faces, weights, tributary, spacing, depth, volume,
+             work, added, touched, limit, due, stiffness, place, keep_stiffness, count_moving):
+    """Counter vertex ``j``'s ``share`` of a pair's energy ``energy`` (J) and
+    volume ``dv`` (m³), the pair pressing ``delta`` (m, < 0) into ``face``
+    at ``weights``: its work, volume, depth, lag (a vertex starts lagging, or
+    is due to move once its lag reaches its limit) and stiffness; updates
+    ``count_moving`` (the lagging and moving vertices' counts, and 1 in its
+    last entry once a vertex sank deeper than SPACING_FRACTION of its
+    spacing)."""
+    work[j] += share * energy
+    if dv > 0.0:
+        volume[j] += share * dv
+        sink = share * dv / tributary[j]
+        depth[j] += sink
+        if place[j] < 0:
+            # it starts lagging
+            place[j] = count_moving[0]
+            touched[count_moving[0]] = j
+            count_moving[0] += 1
+        added[j] += sink
+        # (-delta: the pair's penetration; none, and it moves now)
+        lag = LAG_FRACTION * min(-delta, spacing[j])
+        if lag < limit[j]:
+            limit[j] = lag
+        if added[j] >= limit[j] and limit[j] > -np.inf:
+            # its lag reached its limit: it moves after the step
+            # (limit -inf marks it for _refit)
+            due[count_moving[1]] = j
+            count_moving[1] += 1
+            limit[j] = -np.inf
+        if added[j] > SPACING_FRACTION * spacing[j]:
+            count_moving[2] = 1
+        if keep_stiffness and delta < 0.0:
+            # its depth changes the pair's penetration by its own weight on
+            # the face (0 off the face: a spread share)
+            own = 0.0
+            for corner in range(3):
+                if faces[face, corner] == j:
+                    own = weights[corner]
+            stiffness[j] -= own * sink / delta
+
+
+@njit(cache=True)
+def _spread(k, part, count_moving):
+    """Spread what waits on vertex ``k`` of a spreading counter-part over
+    the vertices around it (:func:`_deposit`, no stiffness: it was counted
+    at ``k``), and take it off the pending list."""
+    (_, faces, _, _, tributary, spacing, _, _, _, _, depth, volume, work, added, touched, limit,
+     due, _, stiffness, place, spread) = part
+    starts, items, weights = spread[0], spread[1], spread[2]
+    pending, pending_list, pending_place, pending_count = spread[4], spread[5], spread[6], spread[7]
+    dv, energy, delta = pending[0, k], pending[1, k], -pending[2, k]
+    for e in range(starts[k], starts[k + 1]):
+        _deposit(items[e], weights[e], energy, dv, delta, -1, faces, (0.0, 0.0, 0.0), tributary,
+                 spacing, depth, volume, work, added, touched, limit, due, stiffness, place,
+                 False, count_moving)
+    pending[0, k] = pending[1, k] = 0.0
+    pending[2, k] = np.inf
+    # (the last one takes its place)
+    pending_count[0] -= 1
+    last = pending_list[pending_count[0]]
+    pending_list[pending_place[k]] = last
+    pending_place[last] = pending_place[k]
+    pending_place[k] = -1
+
+
 @njit(cache=True)
 def settle_counter(part):
-    """Move every lagging vertex of counter-part ``part`` to its depth (its
-    faces fitted anew): the counter where its depth puts it."""
+    """Spread whatever waits on a spreading counter-part's vertices, then
+    move every lagging vertex of counter-part ``part`` to its depth (its
+    faces fitted anew): the counter where its depth puts it. Returns -1, or
+    a vertex the spreading sank deeper than :data:`SPACING_FRACTION` of its
+    spacing since it last moved."""
+    spread = part[20]
+    count_moving = np.zeros(3, np.int64)
+    count_moving[0] = part[17][0]
+    while spread[7][0] > 0:
+        _spread(spread[5][spread[7][0] - 1], part, count_moving)
+    part[17][0] = count_moving[0]
+    worst = -1
+    if count_moving[2] > 0:
+        for c in range(count_moving[0]):
+            j = part[14][c]
+            if part[13][j] > SPACING_FRACTION * part[5][j]:
+                worst = j
+                break
     touched, limit, due, lagging, place = part[14], part[15], part[16], part[17], part[19]
     count = lagging[0]
     for c in range(count):
@@ -305,6 +417,7 @@ def settle_counter(part):
         place[j] = -1
     lagging[0] = 0
     _move(part, count)
+    return worst
 
 
 @njit(cache=True)
@@ -312,7 +425,7 @@ def _move(part, moving):
     """Move the first ``moving`` vertices of ``due`` (their limit -inf) to
     their depth and fit their faces anew."""
     (_, faces, reference, normals, _, _, starts, items, vertices, frames, depth, _, _, added,
-     _, limit, due, _, _, _) = part
+     _, limit, due, _, _, _, _) = part
     if moving >= PARALLEL_REFIT:
         _refit_parallel(due, moving, limit, reference, depth, normals, vertices, faces,
                         frames, starts, items)

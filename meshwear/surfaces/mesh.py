@@ -48,6 +48,17 @@ def bvh(vertices, faces):
     return model
 
 
+#: the spread of a worn surface whose vertices keep their shares
+NO_SPREAD = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0))
+
+#: a worn counter vertex spreads a contact's share over its neighbours when
+#: the spread's radius is more than this many times its mean edge
+SPREAD_FROM = 1.5
+
+#: neighbours whose unworn normals are within 60 degrees share a spread
+SPREAD_FACING = 0.5
+
+
 class MeshSurface(CounterSurface):
     """A rigid counter mesh: its faces in its own frame, placed by
     ``orientation`` (quaternion) and ``position`` and moved by ``rotation`` and
@@ -185,9 +196,59 @@ class MeshSurface(CounterSurface):
         self.vertex_face_items = np.ascontiguousarray(order // 3, dtype=np.int64)
         self.vertex_face_starts = np.concatenate(
             [[0], np.cumsum(np.bincount(corners, minlength=len(self.vertices)))]).astype(np.int64)
+        self.spread = NO_SPREAD
         self.worn = True
         self.invariant = False
         self._compiled = None
+
+    def spread_over(self, radius):
+        """Let each contact's share of a vertex go on over the vertices
+        around it within ``radius`` (m): the area the contact stands for
+        (docs/model.md, "Worn counter-surfaces"). Vertex ``j`` at ``r`` from
+        vertex ``k``, its unworn normal within 60 degrees of ``k``'s (not
+        across a crease or through a thin wall), takes the share
+        ``(1 - r²/R²)² A_j``, the shares normalised to add up to 1 (the
+        volume stays where it was put; ``spread`` is ``(starts, items,
+        weights, self)``, the last each vertex's weight on itself); a vertex
+        whose edges are on average more
+        than ``radius`` / :data:`SPREAD_FROM` keeps its share (a counter as
+        coarse as the bodies, or coarser, spreads a contact enough by its
+        own faces)."""
+        self.spread = NO_SPREAD
+        self._compiled = None
+        if not radius > 0.0:
+            return
+        edges = np.concatenate([self.faces[:, [0, 1]], self.faces[:, [1, 2]],
+                                self.faces[:, [2, 0]]])
+        lengths = np.linalg.norm(self.reference_vertices[edges[:, 0]]
+                                 - self.reference_vertices[edges[:, 1]], axis=1)
+        mean_edge = (np.bincount(edges.ravel(), np.repeat(lengths, 2), len(self.tributary))
+                     / np.maximum(np.bincount(edges.ravel(), minlength=len(self.tributary)), 1))
+        spreads = mean_edge * SPREAD_FROM < radius
+        if not spreads.any():
+            return
+        from scipy.spatial import cKDTree
+
+        V, normals, area = self.reference_vertices, self.vertex_normals, self.tributary
+        source = np.flatnonzero(spreads)
+        near = cKDTree(V).query_ball_point(V[source], radius, return_sorted=True)
+        k = np.repeat(source, [len(n) for n in near])
+        j = np.concatenate(near).astype(np.int64)
+        r2 = np.einsum("ij,ij->i", V[j] - V[k], V[j] - V[k]) / (radius * radius)
+        keep = (r2 < 1.0) & (np.einsum("ij,ij->i", normals[j], normals[k]) >= SPREAD_FACING)
+        k, j, weight = k[keep], j[keep], (1.0 - r2[keep]) ** 2 * area[j[keep]]
+        # every other vertex keeps its share (k = j, weight 1)
+        alone = np.flatnonzero(~spreads)
+        k, j = np.concatenate([k, alone]), np.concatenate([j, alone])
+        weight = np.concatenate([weight, np.ones(len(alone))])
+        order = np.lexsort((j, k))
+        k, items, weights = k[order], j[order].astype(np.int64), weight[order]
+        counts = np.bincount(k, minlength=len(V))
+        starts = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        weights = weights / np.repeat(np.add.reduceat(weights, starts[:-1]), counts)
+        self_weight = np.zeros(len(V))
+        np.add.at(self_weight, k[items == k], weights[items == k])
+        self.spread = (starts, items, weights, self_weight)
 
     def attach(self, part):
         """Query and draw the worn geometry of ``part`` (a
@@ -268,7 +329,8 @@ class MeshSurface(CounterSurface):
                 self.tributary, self.spacing, self.vertex_face_starts, self.vertex_face_items,
                 part.vertices, part.frames, part.depth, part.volume, part.work, part.added,
                 part.touched, part.limit, part.due, part.count, part.stiffness,
-                part.place)
+                part.place, (*self.spread, part.pending, part.pending_list,
+                             part.pending_place, part.pending_count))
 
     # ------------------------------------------------------------ the interface
     def ensure_reach(self, reach):
