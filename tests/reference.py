@@ -546,17 +546,16 @@ def _spread_pairs(energy, dv, delta, corners, weights, part):
             k, w = corners[p, c], weights[p, c]
             if w <= 0.0:
                 continue
-            if waiting[k] < 0:
-                waiting[k], pending[2, k] = 1, np.inf
+            waiting[k] = 1
             pending[1, k] += w * energy[p]
             if dv[p] <= 0.0:
                 continue
             pending[0, k] += w * dv[p]
-            pending[2, k] = min(pending[2, k], -delta[p])
+            pending[2, k] += w * dv[p] * -delta[p]
             if len(stiffness) and delta[p] < 0.0:
                 stiffness[k] += w * w * dv[p] * spread[3][k] / (-delta[p] * tributary[k])
             if pending[0, k] >= (PENDING_FRACTION * LAG_FRACTION * tributary[k]
-                                 * min(pending[2, k], spacing[k])):
+                                 * min(pending[2, k] / pending[0, k], spacing[k])):
                 _spread(k, part)
 
 
@@ -568,13 +567,14 @@ def _spread(k, part):
     starts, items, weights, _, pending, _, waiting, _ = spread
     j, s = items[starts[k]:starts[k + 1]], weights[starts[k]:starts[k + 1]]
     volume_k, energy_k, least = pending[:, k]
+    # (the pairs' penetration, weighed by the volume they put there)
+    least = least / volume_k if volume_k > 0.0 else 0.0
     np.add.at(work, j, s * energy_k)
     if volume_k > 0.0:
         np.add.at(volume, j, s * volume_k)
         np.add.at(depth, j, s * volume_k / tributary[j])
         np.minimum.at(limit, j, LAG_FRACTION * np.minimum(least, spacing[j]))
-    pending[0, k] = pending[1, k] = 0.0
-    pending[2, k] = np.inf
+    pending[0, k] = pending[1, k] = pending[2, k] = 0.0
     waiting[k] = -1
 
 

@@ -56,7 +56,7 @@ part : tuple
     ``starts[k]:starts[k + 1]``; they add up to 1), each vertex's weight on
     itself (V,), then what waits to be spread: ``pending`` (3, V) (the
     volume, m³, and energy, J, put on each vertex since it last spread, and
-    the least penetration, m, of the pairs that put it, inf for none), the
+    the pairs' penetration times the volume each put there, m⁴), the
     vertices with some (V,) int64, each one's place among them (V,) int64,
     -1 for none, and their count (1,) int64; all empty where each vertex
     keeps its share (:meth:`meshwear.surfaces.MeshSurface.spread_over`).
@@ -285,18 +285,16 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
                 pending_place[k] = pending_count[0]
                 pending_list[pending_count[0]] = k
                 pending_count[0] += 1
-                pending[2, k] = np.inf
             pending[1, k] += weight * energy
             if dv <= 0.0:
                 continue
             pending[0, k] += weight * dv
-            if -delta < pending[2, k]:
-                pending[2, k] = -delta
+            pending[2, k] -= weight * dv * delta
             if keep_stiffness and delta < 0.0:
                 # (what it keeps of its own share: its weight on itself)
                 stiffness[k] -= weight * weight * dv * spread[3][k] / (delta * tributary[k])
             if (pending[0, k] >= PENDING_FRACTION * LAG_FRACTION * tributary[k]
-                    * min(pending[2, k], spacing[k])):
+                    * min(pending[2, k] / pending[0, k], spacing[k])):
                 _spread(k, part, count_moving)
     count, moving, deep = count_moving[0], count_moving[1], count_moving[2] > 0
     worst = -1
@@ -373,13 +371,14 @@ def _spread(k, part, count_moving):
      due, _, stiffness, place, spread) = part
     starts, items, weights = spread[0], spread[1], spread[2]
     pending, pending_list, pending_place, pending_count = spread[4], spread[5], spread[6], spread[7]
-    dv, energy, delta = pending[0, k], pending[1, k], -pending[2, k]
+    dv, energy = pending[0, k], pending[1, k]
+    # (the pairs' penetration, weighed by the volume they put there)
+    delta = -pending[2, k] / dv if dv > 0.0 else 0.0
     for e in range(starts[k], starts[k + 1]):
         _deposit(items[e], weights[e], energy, dv, delta, -1, faces, (0.0, 0.0, 0.0), tributary,
                  spacing, depth, volume, work, added, touched, limit, due, stiffness, place,
                  False, count_moving)
-    pending[0, k] = pending[1, k] = 0.0
-    pending[2, k] = np.inf
+    pending[0, k] = pending[1, k] = pending[2, k] = 0.0
     # (the last one takes its place)
     pending_count[0] -= 1
     last = pending_list[pending_count[0]]
