@@ -247,9 +247,10 @@ class PartState:
         (0,): not kept).
     place : (V,) int64
         Where each lagging vertex is in ``touched``, -1 for the others.
-    pending, pending_list, pending_place, pending_count : (3, V) float, (V,) int64, (V,) int64, (1,) int64
+    pending, pending_list, pending_place, pending_count : (6, V) float, (V,) int64, (V,) int64, (1,) int64
         What waits on each vertex to be spread over its neighbours (volume,
-        energy, least penetration), the vertices with some, each one's place
+        energy, penetration and direction of sliding times volume), the
+        vertices with some, each one's place
         among them and their count (a spreading part:
         :func:`meshwear.kernels.counter_wear.wear_counter`); nothing waits
         between two stretches of steps.
@@ -267,7 +268,7 @@ class PartState:
     count: np.ndarray
     stiffness: np.ndarray = field(default_factory=lambda: np.zeros(0))
     place: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    pending: np.ndarray = field(default_factory=lambda: np.zeros((3, 0)))
+    pending: np.ndarray = field(default_factory=lambda: np.zeros((6, 0)))
     pending_list: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     pending_place: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     pending_count: np.ndarray = field(default_factory=lambda: np.zeros(1, np.int64))
@@ -282,7 +283,7 @@ class PartState:
                    touched=np.zeros(n, np.int64), limit=np.full(n, np.inf),
                    due=np.zeros(n, np.int64), count=np.zeros(1, np.int64),
                    stiffness=np.zeros(n if stiffness else 0), place=np.full(n, -1, np.int64),
-                   pending=np.zeros((3, n)), pending_list=np.zeros(n, np.int64),
+                   pending=np.zeros((6, n)), pending_list=np.zeros(n, np.int64),
                    pending_place=np.full(n, -1, np.int64), pending_count=np.zeros(1, np.int64))
 
 

@@ -19,6 +19,9 @@ LAG_FRACTION = 1e-2
 #: a spreading counter vertex spreads what waits on it once its depth there
 #: reaches this fraction of its lag limit
 PENDING_FRACTION = 0.5
+#: a spread along the pairs' direction of sliding reaches this fraction of
+#: its radius across it
+ALONG = 0.25
 #: law code -> numpy twin of its increment (the twins live beside the
 #: increments in the registry; the kernel's dispatch on codes is what this
 #: checks)
@@ -507,7 +510,10 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
                     count[0] = row + 1
     before = depth.copy()
     if len(spread[0]):
-        _spread_pairs(energy, dv, delta, corners, weights, part)
+        # each slipping pair's direction of sliding, counter frame
+        along = np.where((slipping & (speed > 0.0))[:, None],
+                         s / np.where(speed > 0.0, speed, 1.0)[:, None], 0.0) @ rotation
+        _spread_pairs(energy, dv, delta, corners, weights, part, along)
     else:
         for c in range(3):
             np.add.at(work, corners[:, c], weights[:, c] * energy)
@@ -533,12 +539,12 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
     return deep
 
 
-def _spread_pairs(energy, dv, delta, corners, weights, part):
+def _spread_pairs(energy, dv, delta, corners, weights, part, along):
     """A spreading part's pairs, one after the other (:func:`wear_counter`):
     each corner's share waits there, and spreads over its neighbours once
     its depth there reaches PENDING_FRACTION of its lag limit."""
     tributary, spacing, stiffness, spread = part[4], part[5], part[18], part[20]
-    pending, waiting = spread[4], spread[6]
+    pending, waiting = spread[5], spread[7]
     for p in range(len(energy)):
         if dv[p] <= 0.0 and energy[p] <= 0.0:
             continue
@@ -552,6 +558,8 @@ def _spread_pairs(energy, dv, delta, corners, weights, part):
                 continue
             pending[0, k] += w * dv[p]
             pending[2, k] += w * dv[p] * -delta[p]
+            u = along[p] if along[p] @ pending[3:6, k] >= 0.0 else -along[p]
+            pending[3:6, k] += w * dv[p] * u
             if len(stiffness) and delta[p] < 0.0:
                 stiffness[k] += w * w * dv[p] * spread[3][k] / (-delta[p] * tributary[k])
             if pending[0, k] >= (PENDING_FRACTION * LAG_FRACTION * tributary[k]
@@ -562,19 +570,28 @@ def _spread_pairs(energy, dv, delta, corners, weights, part):
 def _spread(k, part):
     """Twin of :func:`meshwear.kernels.counter_wear._spread` (the pending
     list's order aside)."""
-    (_, _, _, _, tributary, spacing, _, _, _, _, depth, volume, work, _, _, limit, _, _, _, _,
-     spread) = part
-    starts, items, weights, _, pending, _, waiting, _ = spread
+    (_, _, reference, _, tributary, spacing, _, _, _, _, depth, volume, work, _, _, limit, _, _,
+     _, _, spread) = part
+    starts, items, weights, _, radius, pending, _, waiting, _ = spread
     j, s = items[starts[k]:starts[k + 1]], weights[starts[k]:starts[k + 1]]
-    volume_k, energy_k, least = pending[:, k]
+    volume_k, energy_k, least = pending[0:3, k]
     # (the pairs' penetration, weighed by the volume they put there)
     least = least / volume_k if volume_k > 0.0 else 0.0
+    u = pending[3:6, k]
+    if np.linalg.norm(u) > 0.0:
+        u = u / np.linalg.norm(u)
+        d = reference[j] - reference[k]
+        par = d @ u
+        r2 = ((d * d).sum(axis=1) - par * par) / radius[0] ** 2 + (par / (ALONG * radius[0])) ** 2
+        s = np.where(r2 < 1.0, (1.0 - r2) ** 2, 0.0) * tributary[j]
+        s = s / s.sum()
     np.add.at(work, j, s * energy_k)
     if volume_k > 0.0:
+        wore = s > 0.0
         np.add.at(volume, j, s * volume_k)
         np.add.at(depth, j, s * volume_k / tributary[j])
-        np.minimum.at(limit, j, LAG_FRACTION * np.minimum(least, spacing[j]))
-    pending[0, k] = pending[1, k] = pending[2, k] = 0.0
+        np.minimum.at(limit, j[wore], LAG_FRACTION * np.minimum(least, spacing[j[wore]]))
+    pending[:, k] = 0.0
     waiting[k] = -1
 
 
@@ -584,7 +601,7 @@ def settle_counter(part):
      _, _, _, _, spread) = part
     if len(spread[0]):
         before = depth.copy()
-        for k in np.flatnonzero(spread[6] >= 0):
+        for k in np.flatnonzero(spread[7] >= 0):
             _spread(k, part)
         added += depth - before
     moved = added > 0.0

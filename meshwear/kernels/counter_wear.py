@@ -54,9 +54,11 @@ part : tuple
     and ``weights`` float (vertex ``k``'s share of a contact's wear goes on
     to vertex ``items[e]`` by ``weights[e]`` for ``e`` in
     ``starts[k]:starts[k + 1]``; they add up to 1), each vertex's weight on
-    itself (V,), then what waits to be spread: ``pending`` (3, V) (the
-    volume, m³, and energy, J, put on each vertex since it last spread, and
-    the pairs' penetration times the volume each put there, m⁴), the
+    itself (V,), the spread's radius (1,) (m), then what waits to be spread:
+    ``pending`` (6, V) (the volume, m³, and energy, J, put on each vertex
+    since it last spread, the pairs' penetration times the volume each put
+    there, m⁴, and their directions of sliding in the counter's frame times
+    that volume, m³), the
     vertices with some (V,) int64, each one's place among them (V,) int64,
     -1 for none, and their count (1,) int64; all empty where each vertex
     keeps its share (:meth:`meshwear.surfaces.MeshSurface.spread_over`).
@@ -89,7 +91,7 @@ NO_PART = (np.array([-1.0, 0.0]), np.zeros((0, 3), np.int64), np.zeros((0, 3)), 
            np.zeros(0), np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.int64),
            np.zeros(1, np.int64), np.zeros(0), np.zeros(0, np.int64),
            (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0),
-            np.zeros((3, 0)), np.zeros(0, np.int64), np.zeros(0, np.int64),
+            np.zeros(1), np.zeros((6, 0)), np.zeros(0, np.int64), np.zeros(0, np.int64),
             np.zeros(1, np.int64)))
 
 #: a counter vertex may sink by at most this fraction of its shortest edge in
@@ -100,6 +102,10 @@ SPACING_FRACTION = 0.5
 #: penetration of the pairs that wore it since it last moved (or of its
 #: shortest edge, if smaller)
 LAG_FRACTION = 1e-2
+
+#: a spread along the direction its pairs slid in reaches this fraction of
+#: its radius across it
+ALONG = 0.25
 
 #: a spreading part's vertex spreads what waits on it once its depth there
 #: reaches this fraction of the lag at which a vertex moves
@@ -148,9 +154,10 @@ def _pairs(body_vertices, pose, active, area, law, contact_state, normal_force, 
            rotation, frame, counter_law, faces, vertices, at, pairs):
     """Each pair's share of the step's wear on the counter, by slot of
     ``active``: ``at`` the face under it (-1: it wears nothing) and ``pairs``
-    (m, 6) the barycentric weights of its contact point on that face, its
-    dissipated energy (J), its worn volume (m³) and its signed distance to
-    the plane (m). Each pair on its own: the threaded build computes them on
+    (m, 9) the barycentric weights of its contact point on that face, its
+    dissipated energy (J), its worn volume (m³), its signed distance to the
+    plane (m) and the unit direction of its slip in the counter's frame (0
+    in stick). Each pair on its own: the threaded build computes them on
     threads, and :func:`wear_counter` adds them up in slot order."""
     code, k_counter = int(counter_law[0]), counter_law[1]
     f, dt = law[0], law[4]
@@ -192,6 +199,7 @@ def _pairs(body_vertices, pose, active, area, law, contact_state, normal_force, 
         sx, sy, sz = gx - rate * nx, gy - rate * ny, gz - rate * nz
         speed2 = sx * sx + sy * sy + sz * sz
         # the pair's dissipated energy and slip distance in the step
+        speed = 0.0
         if state == SLIP:
             speed = np.sqrt(speed2)
             energy = f * load * speed * dt
@@ -215,6 +223,14 @@ def _pairs(body_vertices, pose, active, area, law, contact_state, normal_force, 
         at[slot] = face
         pairs[slot, 0], pairs[slot, 1], pairs[slot, 2] = weights
         pairs[slot, 3], pairs[slot, 4], pairs[slot, 5] = energy, dv, delta
+        # its slip's direction in the counter's frame (0 in stick)
+        if slip > 0.0:
+            ux, uy, uz = sx / speed, sy / speed, sz / speed
+            pairs[slot, 6] = rotation[0, 0] * ux + rotation[1, 0] * uy + rotation[2, 0] * uz
+            pairs[slot, 7] = rotation[0, 1] * ux + rotation[1, 1] * uy + rotation[2, 1] * uz
+            pairs[slot, 8] = rotation[0, 2] * ux + rotation[1, 2] * uy + rotation[2, 2] * uz
+        else:
+            pairs[slot, 6] = pairs[slot, 7] = pairs[slot, 8] = 0.0
 
 
 _pairs_serial = njit(cache=True)(_named_copy(_pairs, "_pairs_serial"))
@@ -241,10 +257,10 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
      depth, volume, work, added, touched, limit, due, lagging, stiffness, place, spread) = part
     keep_stiffness = stiffness.shape[0] > 0
     spreading = spread[0].shape[0] > 0
-    pending, pending_list, pending_place, pending_count = spread[4], spread[5], spread[6], spread[7]
+    pending, pending_list, pending_place, pending_count = spread[5], spread[6], spread[7], spread[8]
     m = active.shape[0]
     at = np.empty(m, np.int64)
-    pairs = np.empty((m, 6))
+    pairs = np.empty((m, 9))
     if m >= PARALLEL_PAIRS:
         _pairs_parallel(body_vertices, pose, active, area, law, contact_state, normal_force,
                         planes, hint, rotation, frame, counter_law, faces, vertices, at, pairs)
@@ -290,6 +306,14 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
                 continue
             pending[0, k] += weight * dv
             pending[2, k] -= weight * dv * delta
+            # the direction it slid in, weighed by the volume (either way
+            # along it: the sign that agrees with the sum so far)
+            ux, uy, uz = pairs[slot, 6], pairs[slot, 7], pairs[slot, 8]
+            if ux * pending[3, k] + uy * pending[4, k] + uz * pending[5, k] < 0.0:
+                ux, uy, uz = -ux, -uy, -uz
+            pending[3, k] += weight * dv * ux
+            pending[4, k] += weight * dv * uy
+            pending[5, k] += weight * dv * uz
             if keep_stiffness and delta < 0.0:
                 # (what it keeps of its own share: its weight on itself)
                 stiffness[k] -= weight * weight * dv * spread[3][k] / (delta * tributary[k])
@@ -366,25 +390,58 @@ def _deposit(j, share, energy, dv, delta, face, faces, weights, tributary, spaci
 def _spread(k, part, count_moving):
     """Spread what waits on vertex ``k`` of a spreading counter-part over
     the vertices around it (:func:`_deposit`, no stiffness: it was counted
-    at ``k``), and take it off the pending list."""
-    (_, faces, _, _, tributary, spacing, _, _, _, _, depth, volume, work, added, touched, limit,
-     due, _, stiffness, place, spread) = part
-    starts, items, weights = spread[0], spread[1], spread[2]
-    pending, pending_list, pending_place, pending_count = spread[4], spread[5], spread[6], spread[7]
+    at ``k``), and take it off the pending list. Where its pairs slid, the
+    spread reaches :data:`ALONG` as far along their mean direction of
+    sliding as across it (the sliding spreads the wear along it; the spread
+    is for the rows of body vertices across it): vertex ``j`` at
+    ``d_par, d_perp`` from ``k`` takes ``(1 - d_perp²/R² - d_par²/(ALONG R)²)²
+    A_j``, normalised; else the even spread's weights."""
+    (_, faces, reference, _, tributary, spacing, _, _, _, _, depth, volume, work, added, touched,
+     limit, due, _, stiffness, place, spread) = part
+    starts, items, weights, radius = spread[0], spread[1], spread[2], spread[4][0]
+    pending, pending_list, pending_place, pending_count = spread[5], spread[6], spread[7], spread[8]
     dv, energy = pending[0, k], pending[1, k]
     # (the pairs' penetration, weighed by the volume they put there)
     delta = -pending[2, k] / dv if dv > 0.0 else 0.0
-    for e in range(starts[k], starts[k + 1]):
-        _deposit(items[e], weights[e], energy, dv, delta, -1, faces, (0.0, 0.0, 0.0), tributary,
-                 spacing, depth, volume, work, added, touched, limit, due, stiffness, place,
-                 False, count_moving)
-    pending[0, k] = pending[1, k] = pending[2, k] = 0.0
+    ux, uy, uz = pending[3, k], pending[4, k], pending[5, k]
+    length = np.sqrt(ux * ux + uy * uy + uz * uz)
+    first, last = starts[k], starts[k + 1]
+    if length > 0.0:
+        ux, uy, uz = ux / length, uy / length, uz / length
+        total = 0.0
+        for e in range(first, last):
+            total += _along_weight(reference, tributary, k, items[e], ux, uy, uz, radius)
+        for e in range(first, last):
+            share = _along_weight(reference, tributary, k, items[e], ux, uy, uz, radius) / total
+            if share > 0.0:
+                _deposit(items[e], share, energy, dv, delta, -1, faces, (0.0, 0.0, 0.0),
+                         tributary, spacing, depth, volume, work, added, touched, limit, due,
+                         stiffness, place, False, count_moving)
+    else:
+        for e in range(first, last):
+            _deposit(items[e], weights[e], energy, dv, delta, -1, faces, (0.0, 0.0, 0.0),
+                     tributary, spacing, depth, volume, work, added, touched, limit, due,
+                     stiffness, place, False, count_moving)
+    for row in range(6):
+        pending[row, k] = 0.0
     # (the last one takes its place)
     pending_count[0] -= 1
     last = pending_list[pending_count[0]]
     pending_list[pending_place[k]] = last
     pending_place[last] = pending_place[k]
     pending_place[k] = -1
+
+
+@njit(cache=True, inline="always")
+def _along_weight(reference, tributary, k, j, ux, uy, uz, radius):
+    """Vertex ``j``'s weight in a spread from ``k`` along ``u`` (:func:`_spread`)."""
+    dx = reference[j, 0] - reference[k, 0]
+    dy = reference[j, 1] - reference[k, 1]
+    dz = reference[j, 2] - reference[k, 2]
+    along = dx * ux + dy * uy + dz * uz
+    across = dx * dx + dy * dy + dz * dz - along * along
+    r2 = across / (radius * radius) + along * along / (ALONG * ALONG * radius * radius)
+    return (1.0 - r2) * (1.0 - r2) * tributary[j] if r2 < 1.0 else 0.0
 
 
 @njit(cache=True)
@@ -397,8 +454,8 @@ def settle_counter(part):
     spread = part[20]
     count_moving = np.zeros(3, np.int64)
     count_moving[0] = part[17][0]
-    while spread[7][0] > 0:
-        _spread(spread[5][spread[7][0] - 1], part, count_moving)
+    while spread[8][0] > 0:
+        _spread(spread[6][spread[8][0] - 1], part, count_moving)
     part[17][0] = count_moving[0]
     worst = -1
     if count_moving[2] > 0:

@@ -49,7 +49,7 @@ def bvh(vertices, faces):
 
 
 #: the spread of a worn surface whose vertices keep their shares
-NO_SPREAD = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0))
+NO_SPREAD = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros(1))
 
 #: a worn counter vertex spreads a contact's share over its neighbours when
 #: the spread's radius is more than this many times its mean edge
@@ -209,7 +209,10 @@ class MeshSurface(CounterSurface):
         across a crease or through a thin wall), takes the share
         ``(1 - r²/R²)² A_j``, the shares normalised to add up to 1 (the
         volume stays where it was put; ``spread`` is ``(starts, items,
-        weights, self)``, the last each vertex's weight on itself); a vertex
+        weights, self, radius)``, ``self`` each vertex's weight on itself;
+        :func:`meshwear.kernels.counter_wear.wear_counter` spreads along the
+        direction of sliding as far as :data:`meshwear.kernels.counter_wear.ALONG`
+        of ``radius``); a vertex
         whose edges are on average more
         than ``radius`` / :data:`SPREAD_FROM` keeps its share (a counter as
         coarse as the bodies, or coarser, spreads a contact enough by its
@@ -248,7 +251,7 @@ class MeshSurface(CounterSurface):
         weights = weights / np.repeat(np.add.reduceat(weights, starts[:-1]), counts)
         self_weight = np.zeros(len(V))
         np.add.at(self_weight, k[items == k], weights[items == k])
-        self.spread = (starts, items, weights, self_weight)
+        self.spread = (starts, items, weights, self_weight, np.array([float(radius)]))
 
     def attach(self, part):
         """Query and draw the worn geometry of ``part`` (a
