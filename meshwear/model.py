@@ -247,10 +247,10 @@ class PartState:
         (0,): not kept).
     place : (V,) int64
         Where each lagging vertex is in ``touched``, -1 for the others.
-    pending, pending_list, pending_place, pending_count : (6, V) float, (V,) int64, (V,) int64, (1,) int64
-        What waits on each vertex to be spread over its neighbours (volume,
-        energy, penetration and direction of sliding times volume), the
-        vertices with some, each one's place
+    pending, pending_list, pending_place, pending_count : (9, F) float, (F,) int64, (F,) int64, (1,) int64
+        What waits on each face to be spread over the vertices around it
+        (volume, energy, penetration, direction of sliding and contact point
+        times volume), the faces with some, each one's place
         among them and their count (a spreading part:
         :func:`meshwear.kernels.counter_wear.wear_counter`); nothing waits
         between two stretches of steps.
@@ -268,7 +268,7 @@ class PartState:
     count: np.ndarray
     stiffness: np.ndarray = field(default_factory=lambda: np.zeros(0))
     place: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    pending: np.ndarray = field(default_factory=lambda: np.zeros((6, 0)))
+    pending: np.ndarray = field(default_factory=lambda: np.zeros((9, 0)))
     pending_list: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     pending_place: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     pending_count: np.ndarray = field(default_factory=lambda: np.zeros(1, np.int64))
@@ -283,8 +283,10 @@ class PartState:
                    touched=np.zeros(n, np.int64), limit=np.full(n, np.inf),
                    due=np.zeros(n, np.int64), count=np.zeros(1, np.int64),
                    stiffness=np.zeros(n if stiffness else 0), place=np.full(n, -1, np.int64),
-                   pending=np.zeros((6, n)), pending_list=np.zeros(n, np.int64),
-                   pending_place=np.full(n, -1, np.int64), pending_count=np.zeros(1, np.int64))
+                   pending=np.zeros((9, len(surface.faces))),
+                   pending_list=np.zeros(len(surface.faces), np.int64),
+                   pending_place=np.full(len(surface.faces), -1, np.int64),
+                   pending_count=np.zeros(1, np.int64))
 
 
 @dataclass(eq=False)
@@ -356,9 +358,9 @@ def build_model(scene):
             surface.make_worn(code_of(s.law or scene.wear.law),
                               scene.wear.coefficient if s.coefficient is None else s.coefficient)
             # a contact wears the area its body vertex stands for
-            surface.spread_over(SPREAD * max((contact_spacing(b, sb)
-                                              for b, sb in zip(bodies, scene.bodies)),
-                                             default=0.0))
+            spacing = max((contact_spacing(b, sb) for b, sb in zip(bodies, scene.bodies)),
+                          default=0.0)
+            surface.spread_over(SPREAD * spacing, SPREAD_BELOW * spacing)
     if mechanism is not None:
         # refined or made worn: the riders anew
         mechanism.surfaces = []
@@ -664,10 +666,14 @@ def _build_body(scene, index, body, surface_set, mechanism=None):
         refinement=refinement)
 
 
-#: a worn counter-part spreads a contact's wear over this many times the
-#: spacing of the bodies' vertices that meet it (docs/model.md, "Worn
-#: counter-surfaces")
-SPREAD = 2.5
+#: a worn counter-part spreads a contact's wear as far as this many times
+#: the spacing of the bodies' vertices that meet it, across the direction
+#: it slid in (docs/model.md, "Worn counter-surfaces")
+SPREAD = 3.5
+
+#: a worn counter's vertices spread a contact's wear where their edges are
+#: on average shorter than this many times the bodies' spacing
+SPREAD_BELOW = 2.0
 
 
 def contact_spacing(body, scene_body):

@@ -21,7 +21,7 @@ LAG_FRACTION = 1e-2
 PENDING_FRACTION = 0.5
 #: a spread along the pairs' direction of sliding reaches this fraction of
 #: its radius across it
-ALONG = 0.25
+ALONG = 0.18
 #: law code -> numpy twin of its increment (the twins live beside the
 #: increments in the registry; the kernel's dispatch on codes is what this
 #: checks)
@@ -513,7 +513,7 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
         # each slipping pair's direction of sliding, counter frame
         along = np.where((slipping & (speed > 0.0))[:, None],
                          s / np.where(speed > 0.0, speed, 1.0)[:, None], 0.0) @ rotation
-        _spread_pairs(energy, dv, delta, corners, weights, part, along)
+        _spread_pairs(energy, dv, delta, corners, weights, part, along, q, hint[i])
     else:
         for c in range(3):
             np.add.at(work, corners[:, c], weights[:, c] * energy)
@@ -539,60 +539,92 @@ def wear_counter(body_vertices, pose, active, area_vectors, law, contact_state, 
     return deep
 
 
-def _spread_pairs(energy, dv, delta, corners, weights, part, along):
+def _spread_pairs(energy, dv, delta, corners, weights, part, along, q, face_of):
     """A spreading part's pairs, one after the other (:func:`wear_counter`):
-    each corner's share waits there, and spreads over its neighbours once
-    its depth there reaches PENDING_FRACTION of its lag limit."""
-    tributary, spacing, stiffness, spread = part[4], part[5], part[18], part[20]
-    pending, waiting = spread[5], spread[7]
+    each one's wear waits on the face under it (with its point, weighed by
+    volume), and a face spreads once its depth there reaches
+    PENDING_FRACTION of its lag limit; a face whose first corner keeps its
+    share takes the pair at its corners as an unspread part does."""
+    faces, tributary, spacing, stiffness, spread = part[1], part[4], part[5], part[18], part[20]
+    starts, self_weight, face_area, pending, waiting = (spread[0], spread[3], spread[5],
+                                                        spread[6], spread[8])
     for p in range(len(energy)):
         if dv[p] <= 0.0 and energy[p] <= 0.0:
             continue
+        f = face_of[p]
+        spreads = starts[faces[f, 0] + 1] - starts[faces[f, 0]] > 1
         for c in range(3):
             k, w = corners[p, c], weights[p, c]
             if w <= 0.0:
                 continue
-            waiting[k] = 1
-            pending[1, k] += w * energy[p]
-            if dv[p] <= 0.0:
-                continue
-            pending[0, k] += w * dv[p]
-            pending[2, k] += w * dv[p] * -delta[p]
-            u = along[p] if along[p] @ pending[3:6, k] >= 0.0 else -along[p]
-            pending[3:6, k] += w * dv[p] * u
-            if len(stiffness) and delta[p] < 0.0:
-                stiffness[k] += w * w * dv[p] * spread[3][k] / (-delta[p] * tributary[k])
-            if pending[0, k] >= (PENDING_FRACTION * LAG_FRACTION * tributary[k]
-                                 * min(pending[2, k] / pending[0, k], spacing[k])):
-                _spread(k, part)
+            if not spreads:
+                _deposit(part, k, w * energy[p], w * dv[p], -delta[p])
+                if len(stiffness) and dv[p] > 0.0 and delta[p] < 0.0:
+                    stiffness[k] += w * w * dv[p] / (-delta[p] * tributary[k])
+            elif len(stiffness) and dv[p] > 0.0 and delta[p] < 0.0:
+                stiffness[k] += w * w * dv[p] * self_weight[k] / (-delta[p] * tributary[k])
+        if not spreads:
+            continue
+        waiting[f] = 1
+        pending[1, f] += energy[p]
+        if dv[p] <= 0.0:
+            continue
+        pending[0, f] += dv[p]
+        pending[2, f] += dv[p] * -delta[p]
+        u = along[p] if along[p] @ pending[3:6, f] >= 0.0 else -along[p]
+        pending[3:6, f] += dv[p] * u
+        pending[6:9, f] += dv[p] * q[p]
+        if pending[0, f] >= (PENDING_FRACTION * LAG_FRACTION * face_area[f]
+                             * min(pending[2, f] / pending[0, f], spacing[faces[f]].min())):
+            _spread_face(f, part)
 
 
-def _spread(k, part):
-    """Twin of :func:`meshwear.kernels.counter_wear._spread` (the pending
-    list's order aside)."""
-    (_, _, reference, _, tributary, spacing, _, _, _, _, depth, volume, work, _, _, limit, _, _,
-     _, _, spread) = part
-    starts, items, weights, _, radius, pending, _, waiting, _ = spread
-    j, s = items[starts[k]:starts[k + 1]], weights[starts[k]:starts[k + 1]]
-    volume_k, energy_k, least = pending[0:3, k]
-    # (the pairs' penetration, weighed by the volume they put there)
-    least = least / volume_k if volume_k > 0.0 else 0.0
-    u = pending[3:6, k]
+def _deposit(part, j, energy, volume_, penetration):
+    """A counter vertex's share of a pair's energy and volume (work,
+    volume, depth and lag limit; the twin moves vertices at the step's end)."""
+    tributary, spacing, depth, volume, work, limit = (part[4], part[5], part[10], part[11],
+                                                      part[12], part[15])
+    work[j] += energy
+    if volume_ > 0.0:
+        volume[j] += volume_
+        depth[j] += volume_ / tributary[j]
+        limit[j] = min(limit[j], LAG_FRACTION * min(penetration, spacing[j]))
+
+
+def _spread_face(f, part):
+    """Twin of :func:`meshwear.kernels.counter_wear._spread_face` (the
+    pending list's order aside)."""
+    (_, faces, reference, normals, tributary, _, _, _, _, _, _, _, _, _, _, _, _, _, _, _,
+     spread) = part
+    starts, items, radius, pending, waiting = spread[0], spread[1], spread[4][0], spread[6], spread[8]
+    volume_f, energy_f, penetration = pending[0:3, f]
+    penetration = penetration / volume_f if volume_f > 0.0 else 0.0
+    a = faces[f, 0]
+    point = pending[6:9, f] / volume_f if volume_f > 0.0 else reference[faces[f]].mean(axis=0)
+    j = items[starts[a]:starts[a + 1]]
+    d = reference[j] - point
+    u = pending[3:6, f]
     if np.linalg.norm(u) > 0.0:
         u = u / np.linalg.norm(u)
-        d = reference[j] - reference[k]
+        corners = reference[faces[f]]
+        longest = np.linalg.norm(corners - np.roll(corners, -1, axis=0), axis=1).max()
+        along = max(ALONG * radius, longest)
         par = d @ u
-        r2 = ((d * d).sum(axis=1) - par * par) / radius[0] ** 2 + (par / (ALONG * radius[0])) ** 2
-        s = np.where(r2 < 1.0, (1.0 - r2) ** 2, 0.0) * tributary[j]
-        s = s / s.sum()
-    np.add.at(work, j, s * energy_k)
-    if volume_k > 0.0:
-        wore = s > 0.0
-        np.add.at(volume, j, s * volume_k)
-        np.add.at(depth, j, s * volume_k / tributary[j])
-        np.minimum.at(limit, j[wore], LAG_FRACTION * np.minimum(least, spacing[j[wore]]))
-    pending[:, k] = 0.0
-    waiting[k] = -1
+        r2 = ((d * d).sum(axis=1) - par * par) / radius ** 2 + par * par / along ** 2
+    else:
+        r2 = (d * d).sum(axis=1) / radius ** 2
+    share = np.where((r2 < 1.0) & (normals[j] @ normals[a] >= 0.5), (1.0 - r2) ** 2, 0.0)
+    share = share * tributary[j]
+    if share.sum() > 0.0:
+        share = share / share.sum()
+    else:
+        j = faces[f]
+        share = closest_points(reference[j][None], point[None])[1][0]
+    for jj, ss in zip(j, share):
+        if ss > 0.0:
+            _deposit(part, jj, ss * energy_f, ss * volume_f, penetration)
+    pending[:, f] = 0.0
+    waiting[f] = -1
 
 
 def settle_counter(part):
@@ -601,8 +633,8 @@ def settle_counter(part):
      _, _, _, _, spread) = part
     if len(spread[0]):
         before = depth.copy()
-        for k in np.flatnonzero(spread[7] >= 0):
-            _spread(k, part)
+        for f in np.flatnonzero(spread[8] >= 0):
+            _spread_face(f, part)
         added += depth - before
     moved = added > 0.0
     vertices[moved] = reference[moved] - depth[moved, None] * normals[moved]

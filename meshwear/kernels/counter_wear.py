@@ -54,21 +54,24 @@ part : tuple
     and ``weights`` float (vertex ``k``'s share of a contact's wear goes on
     to vertex ``items[e]`` by ``weights[e]`` for ``e`` in
     ``starts[k]:starts[k + 1]``; they add up to 1), each vertex's weight on
-    itself (V,), the spread's radius (1,) (m), then what waits to be spread:
-    ``pending`` (6, V) (the volume, m³, and energy, J, put on each vertex
-    since it last spread, the pairs' penetration times the volume each put
-    there, m⁴, and their directions of sliding in the counter's frame times
-    that volume, m³), the
-    vertices with some (V,) int64, each one's place among them (V,) int64,
+    itself (V,), the spread's radius (1,) (m), each face's unworn area (F,),
+    then what waits to be spread: ``pending`` (9, F) (the volume, m³, and
+    energy, J, put on each face since it last spread, and the pairs'
+    penetration, directions of sliding and contact points in the counter's
+    frame, each times the volume it put there), the faces with some
+    (F,) int64, each one's place among them (F,) int64,
     -1 for none, and their count (1,) int64; all empty where each vertex
     keeps its share (:meth:`meshwear.surfaces.MeshSurface.spread_over`).
 
-A spreading part takes each pair's shares of the face's corners as pending
-at those corners and spreads a corner's pending wear over its neighbours
-once its depth there reaches :data:`PENDING_FRACTION` of its lag limit
-(and every pending vertex's in :func:`settle_counter`): a pair's share of a
-corner is a thousandth of a contact's penetration or less, and spreading
-each one at once over its tens of neighbours cost ten times the step.
+A spreading part keeps each pair's wear waiting on the face under it (with
+the point it was put at, weighed by volume) and spreads a face's waiting
+wear from that point over the vertices around it once its depth there
+reaches :data:`PENDING_FRACTION` of the lag at which a vertex moves (and
+every face's in :func:`settle_counter`): a pair's wear is a thousandth of a
+contact's penetration or less, and spreading each at once over its tens of
+neighbours cost ten times the step; spread from the face's corners instead
+of that point, the rows of body vertices beat against the counter's and
+left the counter's depth 5 % uneven in stripes a few rows wide.
 """
 
 import numpy as np
@@ -91,8 +94,8 @@ NO_PART = (np.array([-1.0, 0.0]), np.zeros((0, 3), np.int64), np.zeros((0, 3)), 
            np.zeros(0), np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.int64),
            np.zeros(1, np.int64), np.zeros(0), np.zeros(0, np.int64),
            (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0),
-            np.zeros(1), np.zeros((6, 0)), np.zeros(0, np.int64), np.zeros(0, np.int64),
-            np.zeros(1, np.int64)))
+            np.zeros(1), np.zeros(0), np.zeros((9, 0)), np.zeros(0, np.int64),
+            np.zeros(0, np.int64), np.zeros(1, np.int64)))
 
 #: a counter vertex may sink by at most this fraction of its shortest edge in
 #: one step; deeper, its faces could fold over
@@ -103,9 +106,13 @@ SPACING_FRACTION = 0.5
 #: shortest edge, if smaller)
 LAG_FRACTION = 1e-2
 
+#: a counter vertex takes a share of a spread only if its unworn normal is
+#: within 60 degrees of the spread's (not across a crease or a thin wall)
+SPREAD_FACING = 0.5
+
 #: a spread along the direction its pairs slid in reaches this fraction of
 #: its radius across it
-ALONG = 0.25
+ALONG = 0.18
 
 #: a spreading part's vertex spreads what waits on it once its depth there
 #: reaches this fraction of the lag at which a vertex moves
@@ -154,10 +161,10 @@ def _pairs(body_vertices, pose, active, area, law, contact_state, normal_force, 
            rotation, frame, counter_law, faces, vertices, at, pairs):
     """Each pair's share of the step's wear on the counter, by slot of
     ``active``: ``at`` the face under it (-1: it wears nothing) and ``pairs``
-    (m, 9) the barycentric weights of its contact point on that face, its
+    (m, 12) the barycentric weights of its contact point on that face, its
     dissipated energy (J), its worn volume (m³), its signed distance to the
-    plane (m) and the unit direction of its slip in the counter's frame (0
-    in stick). Each pair on its own: the threaded build computes them on
+    plane (m), the unit direction of its slip in the counter's frame (0 in
+    stick) and its contact point there (m). Each pair on its own: the threaded build computes them on
     threads, and :func:`wear_counter` adds them up in slot order."""
     code, k_counter = int(counter_law[0]), counter_law[1]
     f, dt = law[0], law[4]
@@ -231,6 +238,7 @@ def _pairs(body_vertices, pose, active, area, law, contact_state, normal_force, 
             pairs[slot, 8] = rotation[0, 2] * ux + rotation[1, 2] * uy + rotation[2, 2] * uz
         else:
             pairs[slot, 6] = pairs[slot, 7] = pairs[slot, 8] = 0.0
+        pairs[slot, 9], pairs[slot, 10], pairs[slot, 11] = qx, qy, qz
 
 
 _pairs_serial = njit(cache=True)(_named_copy(_pairs, "_pairs_serial"))
@@ -257,10 +265,10 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
      depth, volume, work, added, touched, limit, due, lagging, stiffness, place, spread) = part
     keep_stiffness = stiffness.shape[0] > 0
     spreading = spread[0].shape[0] > 0
-    pending, pending_list, pending_place, pending_count = spread[5], spread[6], spread[7], spread[8]
+    pending, pending_list, pending_place, pending_count = spread[6], spread[7], spread[8], spread[9]
     m = active.shape[0]
     at = np.empty(m, np.int64)
-    pairs = np.empty((m, 9))
+    pairs = np.empty((m, 12))
     if m >= PARALLEL_PAIRS:
         _pairs_parallel(body_vertices, pose, active, area, law, contact_state, normal_force,
                         planes, hint, rotation, frame, counter_law, faces, vertices, at, pairs)
@@ -291,35 +299,15 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
                     log_index[row, 2] = k
                     log_value[row] = weight * normal_force[active[slot]]
                 log_count[0] = row + 1
-            if not spreading:
+            if not spreading or spread[0][faces[face, 0] + 1] - spread[0][faces[face, 0]] <= 1:
                 _deposit(k, weight, energy, dv, delta, face, faces, weights, tributary, spacing,
                          depth, volume, work, added, touched, limit, due, stiffness, place,
                          keep_stiffness, count_moving)
-                continue
-            # it waits at the corner, and spreads once deep enough there
-            if pending_place[k] < 0:
-                pending_place[k] = pending_count[0]
-                pending_list[pending_count[0]] = k
-                pending_count[0] += 1
-            pending[1, k] += weight * energy
-            if dv <= 0.0:
-                continue
-            pending[0, k] += weight * dv
-            pending[2, k] -= weight * dv * delta
-            # the direction it slid in, weighed by the volume (either way
-            # along it: the sign that agrees with the sum so far)
-            ux, uy, uz = pairs[slot, 6], pairs[slot, 7], pairs[slot, 8]
-            if ux * pending[3, k] + uy * pending[4, k] + uz * pending[5, k] < 0.0:
-                ux, uy, uz = -ux, -uy, -uz
-            pending[3, k] += weight * dv * ux
-            pending[4, k] += weight * dv * uy
-            pending[5, k] += weight * dv * uz
-            if keep_stiffness and delta < 0.0:
+            elif keep_stiffness and dv > 0.0 and delta < 0.0:
                 # (what it keeps of its own share: its weight on itself)
                 stiffness[k] -= weight * weight * dv * spread[3][k] / (delta * tributary[k])
-            if (pending[0, k] >= PENDING_FRACTION * LAG_FRACTION * tributary[k]
-                    * min(pending[2, k] / pending[0, k], spacing[k])):
-                _spread(k, part, count_moving)
+        if spreading and spread[0][faces[face, 0] + 1] - spread[0][faces[face, 0]] > 1:
+            _wait(face, pairs, slot, part, count_moving)
     count, moving, deep = count_moving[0], count_moving[1], count_moving[2] > 0
     worst = -1
     if deep:
@@ -386,62 +374,136 @@ def _deposit(j, share, energy, dv, delta, face, faces, weights, tributary, spaci
             stiffness[j] -= own * sink / delta
 
 
+@njit(cache=True, inline="always")
+def _wait(face, pairs, slot, part, count_moving):
+    """Pair ``slot`` of ``pairs`` puts its wear on ``face`` of a spreading
+    counter-part to wait there (volume, energy, its penetration, direction
+    of sliding and contact point, each weighed by the volume), and the face
+    spreads it once its depth there reaches :data:`PENDING_FRACTION` of the
+    lag at which a vertex moves (:func:`_spread_face`)."""
+    spacing, spread = part[5], part[20]
+    face_area = spread[5]
+    pending, pending_list, pending_place, pending_count = spread[6], spread[7], spread[8], spread[9]
+    energy, dv, delta = pairs[slot, 3], pairs[slot, 4], pairs[slot, 5]
+    if pending_place[face] < 0:
+        pending_place[face] = pending_count[0]
+        pending_list[pending_count[0]] = face
+        pending_count[0] += 1
+    pending[1, face] += energy
+    if dv <= 0.0:
+        return
+    pending[0, face] += dv
+    pending[2, face] -= dv * delta
+    # the direction it slid in (either way along it: the sign that agrees
+    # with the sum so far)
+    ux, uy, uz = pairs[slot, 6], pairs[slot, 7], pairs[slot, 8]
+    if ux * pending[3, face] + uy * pending[4, face] + uz * pending[5, face] < 0.0:
+        ux, uy, uz = -ux, -uy, -uz
+    pending[3, face] += dv * ux
+    pending[4, face] += dv * uy
+    pending[5, face] += dv * uz
+    pending[6, face] += dv * pairs[slot, 9]
+    pending[7, face] += dv * pairs[slot, 10]
+    pending[8, face] += dv * pairs[slot, 11]
+    faces = part[1]
+    least = min(spacing[faces[face, 0]], spacing[faces[face, 1]], spacing[faces[face, 2]])
+    if (pending[0, face] >= PENDING_FRACTION * LAG_FRACTION * face_area[face]
+            * min(pending[2, face] / pending[0, face], least)):
+        _spread_face(face, part, count_moving)
+
+
 @njit(cache=True)
-def _spread(k, part, count_moving):
-    """Spread what waits on vertex ``k`` of a spreading counter-part over
-    the vertices around it (:func:`_deposit`, no stiffness: it was counted
-    at ``k``), and take it off the pending list. Where its pairs slid, the
-    spread reaches :data:`ALONG` as far along their mean direction of
-    sliding as across it (the sliding spreads the wear along it; the spread
-    is for the rows of body vertices across it): vertex ``j`` at
-    ``d_par, d_perp`` from ``k`` takes ``(1 - d_perp²/R² - d_par²/(ALONG R)²)²
-    A_j``, normalised; else the even spread's weights."""
-    (_, faces, reference, _, tributary, spacing, _, _, _, _, depth, volume, work, added, touched,
-     limit, due, _, stiffness, place, spread) = part
-    starts, items, weights, radius = spread[0], spread[1], spread[2], spread[4][0]
-    pending, pending_list, pending_place, pending_count = spread[5], spread[6], spread[7], spread[8]
-    dv, energy = pending[0, k], pending[1, k]
+def _spread_face(face, part, count_moving):
+    """Spread what waits on ``face`` of a spreading counter-part over the
+    vertices around the point it was put at (the contact points weighed by
+    volume; :func:`_deposit`, no stiffness: it was counted at the face's
+    corners), and take it off the pending list. Vertex ``j`` at ``d_par,
+    d_perp`` from that point along and across the pairs' mean direction of
+    sliding takes ``(1 - d_perp²/R² - d_par²/R_par²)² A_j``, normalised
+    (``R_par`` :data:`ALONG` times ``R``, or the face's longest edge if more:
+    the sliding spreads the wear along it; the spread is for the rows of body
+    vertices across it); ``d²/R²`` in every direction where no direction is
+    known (energy in stick); the face's corners by the point's weights where
+    no vertex is within reach."""
+    (_, faces, reference, normals, tributary, spacing, _, _, _, _, depth, volume, work, added,
+     touched, limit, due, _, stiffness, place, spread) = part
+    starts, items, radius = spread[0], spread[1], spread[4][0]
+    pending, pending_list, pending_place, pending_count = spread[6], spread[7], spread[8], spread[9]
+    dv, energy = pending[0, face], pending[1, face]
     # (the pairs' penetration, weighed by the volume they put there)
-    delta = -pending[2, k] / dv if dv > 0.0 else 0.0
-    ux, uy, uz = pending[3, k], pending[4, k], pending[5, k]
+    delta = -pending[2, face] / dv if dv > 0.0 else 0.0
+    a, b, c = faces[face, 0], faces[face, 1], faces[face, 2]
+    if dv > 0.0:
+        px, py, pz = pending[6, face] / dv, pending[7, face] / dv, pending[8, face] / dv
+    else:
+        px = (reference[a, 0] + reference[b, 0] + reference[c, 0]) / 3.0
+        py = (reference[a, 1] + reference[b, 1] + reference[c, 1]) / 3.0
+        pz = (reference[a, 2] + reference[b, 2] + reference[c, 2]) / 3.0
+    ux, uy, uz = pending[3, face], pending[4, face], pending[5, face]
     length = np.sqrt(ux * ux + uy * uy + uz * uz)
-    first, last = starts[k], starts[k + 1]
+    along = radius
     if length > 0.0:
         ux, uy, uz = ux / length, uy / length, uz / length
-        total = 0.0
+        longest = 0.0
+        for p, q in ((a, b), (b, c), (c, a)):
+            e2 = ((reference[p, 0] - reference[q, 0]) ** 2 + (reference[p, 1] - reference[q, 1]) ** 2
+                  + (reference[p, 2] - reference[q, 2]) ** 2)
+            longest = max(longest, np.sqrt(e2))
+        along = max(ALONG * radius, longest)
+    nx, ny, nz = normals[a, 0], normals[a, 1], normals[a, 2]
+    first, last = starts[a], starts[a + 1]
+    total = 0.0
+    for e in range(first, last):
+        total += _weight(reference, normals, tributary, items[e], px, py, pz, ux, uy, uz, nx, ny,
+                         nz, length > 0.0, radius, along)
+    if total > 0.0:
         for e in range(first, last):
-            total += _along_weight(reference, tributary, k, items[e], ux, uy, uz, radius)
-        for e in range(first, last):
-            share = _along_weight(reference, tributary, k, items[e], ux, uy, uz, radius) / total
+            share = _weight(reference, normals, tributary, items[e], px, py, pz, ux, uy, uz, nx, ny,
+                            nz, length > 0.0, radius, along) / total
             if share > 0.0:
                 _deposit(items[e], share, energy, dv, delta, -1, faces, (0.0, 0.0, 0.0),
                          tributary, spacing, depth, volume, work, added, touched, limit, due,
                          stiffness, place, False, count_moving)
     else:
-        for e in range(first, last):
-            _deposit(items[e], weights[e], energy, dv, delta, -1, faces, (0.0, 0.0, 0.0),
-                     tributary, spacing, depth, volume, work, added, touched, limit, due,
-                     stiffness, place, False, count_moving)
-    for row in range(6):
-        pending[row, k] = 0.0
+        weights = _corner_weights(reference, a, b, c, px, py, pz)
+        for corner in range(3):
+            if weights[corner] > 0.0:
+                _deposit(faces[face, corner], weights[corner], energy, dv, delta, -1, faces,
+                         (0.0, 0.0, 0.0), tributary, spacing, depth, volume, work, added, touched,
+                         limit, due, stiffness, place, False, count_moving)
+    for row in range(pending.shape[0]):
+        pending[row, face] = 0.0
     # (the last one takes its place)
     pending_count[0] -= 1
     last = pending_list[pending_count[0]]
-    pending_list[pending_place[k]] = last
-    pending_place[last] = pending_place[k]
-    pending_place[k] = -1
+    pending_list[pending_place[face]] = last
+    pending_place[last] = pending_place[face]
+    pending_place[face] = -1
 
 
 @njit(cache=True, inline="always")
-def _along_weight(reference, tributary, k, j, ux, uy, uz, radius):
-    """Vertex ``j``'s weight in a spread from ``k`` along ``u`` (:func:`_spread`)."""
-    dx = reference[j, 0] - reference[k, 0]
-    dy = reference[j, 1] - reference[k, 1]
-    dz = reference[j, 2] - reference[k, 2]
-    along = dx * ux + dy * uy + dz * uz
-    across = dx * dx + dy * dy + dz * dz - along * along
-    r2 = across / (radius * radius) + along * along / (ALONG * ALONG * radius * radius)
+def _weight(reference, normals, tributary, j, px, py, pz, ux, uy, uz, nx, ny, nz, directed, radius,
+            along):
+    """Vertex ``j``'s weight in a spread from ``p`` (:func:`_spread_face`):
+    none if its normal turns by more than 60 degrees from ``n``."""
+    if normals[j, 0] * nx + normals[j, 1] * ny + normals[j, 2] * nz < SPREAD_FACING:
+        return 0.0
+    dx, dy, dz = reference[j, 0] - px, reference[j, 1] - py, reference[j, 2] - pz
+    d2 = dx * dx + dy * dy + dz * dz
+    if directed:
+        par = dx * ux + dy * uy + dz * uz
+        r2 = (d2 - par * par) / (radius * radius) + par * par / (along * along)
+    else:
+        r2 = d2 / (radius * radius)
     return (1.0 - r2) * (1.0 - r2) * tributary[j] if r2 < 1.0 else 0.0
+
+
+@njit(cache=True, inline="always")
+def _corner_weights(reference, a, b, c, px, py, pz):
+    """Barycentric weights of the closest point of triangle ``abc`` to ``p``."""
+    return closest_on_triangle(px, py, pz, reference[a, 0], reference[a, 1], reference[a, 2],
+                               reference[b, 0], reference[b, 1], reference[b, 2],
+                               reference[c, 0], reference[c, 1], reference[c, 2])[3:6]
 
 
 @njit(cache=True)
@@ -454,8 +516,8 @@ def settle_counter(part):
     spread = part[20]
     count_moving = np.zeros(3, np.int64)
     count_moving[0] = part[17][0]
-    while spread[8][0] > 0:
-        _spread(spread[6][spread[8][0] - 1], part, count_moving)
+    while spread[9][0] > 0:
+        _spread_face(spread[7][spread[9][0] - 1], part, count_moving)
     part[17][0] = count_moving[0]
     worst = -1
     if count_moving[2] > 0:

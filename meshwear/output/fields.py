@@ -62,6 +62,16 @@ def body_quantities(body, s, model):
     }
 
 
+def _spread_matrix(starts, items, weights):
+    """The (V, V) sparse matrix that spreads a per-vertex quantity of a worn
+    counter-part as its wear is spread (:meth:`meshwear.surfaces.MeshSurface.spread_over`):
+    column ``k`` holds vertex ``k``'s weights on the vertices it spreads to."""
+    from scipy.sparse import csc_matrix
+
+    n = len(starts) - 1
+    return csc_matrix((weights, items, starts), shape=(n, n))
+
+
 def _matrix_quaternion(R):
     """Unit quaternion (w, x, y, z), w >= 0, of a rotation matrix."""
     from scipy.spatial.transform import Rotation
@@ -104,6 +114,12 @@ def part_quantities(model, state, m):
             np.add.at(friction_force, corners[:, c], weights[:, c, None] * friction)
             np.maximum.at(contact_state, corners[:, c],
                           np.where(weights[:, c] > 0.0, s.contact_state[slot, pairs], 0))
+    if len(getattr(surface, "spread", ((),))[0]):
+        # the forces spread as the wear is (the area each contact stands for)
+        starts, items, weights = surface.spread[0:3]
+        spread = _spread_matrix(starts, items, weights)
+        normal_force = spread @ normal_force
+        friction_force = spread @ friction_force
     counts = np.bincount(contact_state, minlength=3)
     return {
         "points": surface.world_vertices(part.vertices, state.time),

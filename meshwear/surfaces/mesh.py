@@ -49,11 +49,8 @@ def bvh(vertices, faces):
 
 
 #: the spread of a worn surface whose vertices keep their shares
-NO_SPREAD = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros(1))
-
-#: a worn counter vertex spreads a contact's share over its neighbours when
-#: the spread's radius is more than this many times its mean edge
-SPREAD_FROM = 1.5
+NO_SPREAD = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros(1),
+             np.zeros(0))
 
 #: neighbours whose unworn normals are within 60 degrees share a spread
 SPREAD_FACING = 0.5
@@ -201,22 +198,25 @@ class MeshSurface(CounterSurface):
         self.invariant = False
         self._compiled = None
 
-    def spread_over(self, radius):
-        """Let each contact's share of a vertex go on over the vertices
-        around it within ``radius`` (m): the area the contact stands for
-        (docs/model.md, "Worn counter-surfaces"). Vertex ``j`` at ``r`` from
-        vertex ``k``, its unworn normal within 60 degrees of ``k``'s (not
-        across a crease or through a thin wall), takes the share
-        ``(1 - r²/R²)² A_j``, the shares normalised to add up to 1 (the
-        volume stays where it was put; ``spread`` is ``(starts, items,
-        weights, self, radius)``, ``self`` each vertex's weight on itself;
-        :func:`meshwear.kernels.counter_wear.wear_counter` spreads along the
-        direction of sliding as far as :data:`meshwear.kernels.counter_wear.ALONG`
-        of ``radius``); a vertex
-        whose edges are on average more
-        than ``radius`` / :data:`SPREAD_FROM` keeps its share (a counter as
-        coarse as the bodies, or coarser, spreads a contact enough by its
-        own faces)."""
+    def spread_over(self, radius, finer_than):
+        """Let the wear of each contact spread over the vertices around the
+        point it was put at, within ``radius`` (m) across the direction it
+        slid in (docs/model.md, "Worn counter-surfaces"; the kernel,
+        :func:`meshwear.kernels.counter_wear.wear_counter`, spreads along that
+        direction only :data:`meshwear.kernels.counter_wear.ALONG` as far).
+        Nothing spreads where the counter's vertices, those whose edges are
+        on average shorter than ``radius``, have a median mean edge of
+        ``finer_than`` (m) or more: a counter about as coarse as the bodies,
+        or coarser, spreads a contact by its own faces; else those vertices
+        spread. Sets ``spread``, ``(starts,
+        items, weights, self, radius, face_area)``: for each spreading vertex
+        ``k`` the vertices within ``radius`` past its longest edge (as far as
+        a spread from a point on its faces can reach) whose unworn normals
+        are within 60 degrees of ``k``'s (not across a crease or through a
+        thin wall), with the even spread's weights from ``k``,
+        ``(1 - r²/R²)² A_j`` normalised (the written forces spread by them);
+        ``self`` each vertex's weight on itself (a spread vertex's
+        stiffness); each face's unworn area."""
         self.spread = NO_SPREAD
         self._compiled = None
         if not radius > 0.0:
@@ -227,19 +227,26 @@ class MeshSurface(CounterSurface):
                                  - self.reference_vertices[edges[:, 1]], axis=1)
         mean_edge = (np.bincount(edges.ravel(), np.repeat(lengths, 2), len(self.tributary))
                      / np.maximum(np.bincount(edges.ravel(), minlength=len(self.tributary)), 1))
-        spreads = mean_edge * SPREAD_FROM < radius
-        if not spreads.any():
+        # the counter's spacing where it can be spread on: the median of
+        # its vertices' mean edges, of those shorter than the radius
+        spreads = mean_edge < radius
+        if not spreads.any() or np.median(mean_edge[spreads]) >= finer_than:
             return
         from scipy.spatial import cKDTree
 
         V, normals, area = self.reference_vertices, self.vertex_normals, self.tributary
+        longest = np.zeros(len(V))
+        np.maximum.at(longest, edges.ravel(), np.repeat(lengths, 2))
         source = np.flatnonzero(spreads)
-        near = cKDTree(V).query_ball_point(V[source], radius, return_sorted=True)
+        # (as far as a point on any face at the vertex could spread)
+        near = cKDTree(V).query_ball_point(V[source], radius + longest[source],
+                                           return_sorted=True)
         k = np.repeat(source, [len(n) for n in near])
         j = np.concatenate(near).astype(np.int64)
         r2 = np.einsum("ij,ij->i", V[j] - V[k], V[j] - V[k]) / (radius * radius)
-        keep = (r2 < 1.0) & (np.einsum("ij,ij->i", normals[j], normals[k]) >= SPREAD_FACING)
-        k, j, weight = k[keep], j[keep], (1.0 - r2[keep]) ** 2 * area[j[keep]]
+        keep = np.einsum("ij,ij->i", normals[j], normals[k]) >= SPREAD_FACING
+        k, j = k[keep], j[keep]
+        weight = np.where(r2[keep] < 1.0, (1.0 - np.minimum(r2[keep], 1.0)) ** 2, 0.0) * area[j]
         # every other vertex keeps its share (k = j, weight 1)
         alone = np.flatnonzero(~spreads)
         k, j = np.concatenate([k, alone]), np.concatenate([j, alone])
@@ -251,7 +258,10 @@ class MeshSurface(CounterSurface):
         weights = weights / np.repeat(np.add.reduceat(weights, starts[:-1]), counts)
         self_weight = np.zeros(len(V))
         np.add.at(self_weight, k[items == k], weights[items == k])
-        self.spread = (starts, items, weights, self_weight, np.array([float(radius)]))
+        tri = self.reference_vertices[self.faces]
+        face_area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
+                                         axis=1)
+        self.spread = (starts, items, weights, self_weight, np.array([float(radius)]), face_area)
 
     def attach(self, part):
         """Query and draw the worn geometry of ``part`` (a
