@@ -607,13 +607,14 @@ def _spread_face(f, part):
     if np.linalg.norm(u) > 0.0:
         u = u / np.linalg.norm(u)
         corners = reference[faces[f]]
-        longest = np.linalg.norm(corners - np.roll(corners, -1, axis=0), axis=1).max()
-        along = max(ALONG * radius, longest)
+        edges = np.linalg.norm(corners - np.roll(corners, -1, axis=0), axis=1)
+        along = max(ALONG * radius, 0.5 * (edges.mean() + edges.max()))
         par = d @ u
         r2 = ((d * d).sum(axis=1) - par * par) / radius ** 2 + par * par / along ** 2
     else:
         r2 = (d * d).sum(axis=1) / radius ** 2
-    share = np.where((r2 < 1.0) & (normals[j] @ normals[a] >= 0.5), (1.0 - r2) ** 2, 0.0)
+    # (corner a's list holds the vertices facing within 60 degrees of it)
+    share = np.where(r2 < 1.0, (1.0 - r2) ** 2, 0.0)
     share = share * tributary[j]
     if share.sum() > 0.0:
         share = share / share.sum()

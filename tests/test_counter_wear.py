@@ -191,7 +191,7 @@ def test_the_threaded_builds_give_the_serial_numbers_bit_for_bit(tmp_path):
             disc.faces, part.vertices)
     shares = []
     for kernel in (counter_wear._pairs_serial, counter_wear._pairs_parallel):
-        at, pairs = np.full(len(s.active), -7), np.full((len(s.active), 6), np.nan)
+        at, pairs = np.full(len(s.active), -7), np.full((len(s.active), 12), np.nan)
         kernel(*args, at, pairs)
         shares.append((at, pairs[at >= 0]))
     assert (shares[0][0] >= 0).sum() > 100, "the case must have pairs"
@@ -247,6 +247,65 @@ def test_the_disc_track_follows_the_chord_law(two_turns, measured):
     assert track.sum() > 500
     error = np.abs(part.depth[track] - expected[track]).max() / centre
     assert measured("disc track vs chord law (of centre depth)", error, 0.0, 5e-2) <= 5e-2
+
+
+def _disc_track(model, state):
+    """(depth, chord law's depth, offset u) of the worn disc's running face,
+    and the chord law's depth at the centre line."""
+    disc, part = model.surfaces.per_vertex[0], state.parts[0]
+    p = P / (np.pi * A * A)
+    turns = OMEGA * state.time / (2.0 * np.pi)
+    expected, u = cases.disc_track(disc.reference_vertices, disc.faces, 0.001, R, A, p, K_DISC,
+                                   turns)
+    face = np.abs(disc.reference_vertices[:, 2] - 0.001) < 1e-9
+    return part.depth[face], expected[face], u[face], K_DISC * p * 2.0 * A * turns
+
+
+def test_a_disc_four_times_finer_than_the_pin_wears_a_smooth_track(tmp_path, measured):
+    """The pin's vertices 0.15 mm apart (its refined end face; spacing h_b
+    90 um) on a disc refined to 37.5 um: each contact's wear spreads over the
+    disc vertices around its foot (docs/model.md, "The area a contact stands
+    for"), where one face's corners took it before and left spots 236 % off
+    the chord law. Its volume is k P s, its depth along the track's centre
+    line even, and within the track's inner part (|u| < 0.6 a) it follows
+    the chord law within 5 %; the spread rounds the track's flanks (7.7 %
+    off at |u| < 0.8 a, docs/model.md)."""
+    model = build_model(load_scene(_scene(tmp_path, disc_resolution=3.75e-5)))
+    state = run(model, initial_state(model))
+    assert model.surfaces.per_vertex[0].spread[0].size > 0, "the disc must spread"
+    s = OMEGA * state.time * (R + A * A / (8.0 * R))
+    volume = state.parts[0].volume.sum()
+    assert measured("pin on a 4x finer disc: disc volume (m³)", volume, K_DISC * P * s,
+                    5e-3) <= 5e-3
+    depth, expected, u, centre = _disc_track(model, state)
+    line = np.abs(u) < 0.05 * A
+    assert line.sum() > 200
+    even = (depth[line].max() - depth[line].min()) / centre
+    assert measured("4x finer disc: centre line's depth range (of its depth)", even, 0.0,
+                    5e-2) <= 5e-2
+    inner = np.abs(u) < 0.6 * A
+    error = np.abs(depth[inner] - expected[inner]).max() / centre
+    assert measured("4x finer disc: track |u| < 0.6 a vs chord law (of centre depth)", error,
+                    0.0, 5e-2) <= 5e-2
+
+
+def test_a_counter_far_finer_than_the_bodies_spreads_over_a_shorter_radius(tmp_path, caplog,
+                                                                           monkeypatch):
+    """Its spread lists would outgrow memory: the radius shrinks to fit
+    them, with a notice naming the surface, and the volume stays exact."""
+    from meshwear.surfaces import mesh
+
+    monkeypatch.setattr(mesh, "SPREAD_ENTRIES", 200_000)
+    with caplog.at_level("WARNING", logger="meshwear"):
+        model = build_model(load_scene(_scene(tmp_path, duration=0.1, disc_resolution=6e-5)))
+    spread = model.surfaces.per_vertex[0].spread
+    # (the estimate counts each disc by the vertex's own area: within a few %)
+    assert spread[0].size > 0 and len(spread[1]) <= 1.5 * 200_000
+    assert any("disc: its vertices are" in r.getMessage() and "finer resolution" in
+               r.getMessage() for r in caplog.records)
+    state = run(model, initial_state(model))
+    assert state.parts[0].volume.sum() == pytest.approx(
+        K_DISC / K_PIN * state.bodies[0].wear_volume.sum(), rel=1e-9)
 
 
 def test_compiled_loop_matches_the_python_step_on_a_worn_disc(tmp_path):

@@ -116,7 +116,7 @@ ALONG = 0.18
 
 #: a spreading part's vertex spreads what waits on it once its depth there
 #: reaches this fraction of the lag at which a vertex moves
-PENDING_FRACTION = 0.5
+PENDING_FRACTION = 5.0
 
 #: active vertices from which the pairs' shares are computed on threads
 PARALLEL_PAIRS = 2048
@@ -420,12 +420,13 @@ def _spread_face(face, part, count_moving):
     corners), and take it off the pending list. Vertex ``j`` at ``d_par,
     d_perp`` from that point along and across the pairs' mean direction of
     sliding takes ``(1 - d_perp²/R² - d_par²/R_par²)² A_j``, normalised
-    (``R_par`` :data:`ALONG` times ``R``, or the face's longest edge if more:
+    (``R_par`` :data:`ALONG` times ``R``, or, if more, the mean of the face's
+    mean and longest edges:
     the sliding spreads the wear along it; the spread is for the rows of body
     vertices across it); ``d²/R²`` in every direction where no direction is
     known (energy in stick); the face's corners by the point's weights where
     no vertex is within reach."""
-    (_, faces, reference, normals, tributary, spacing, _, _, _, _, depth, volume, work, added,
+    (_, faces, reference, _, tributary, spacing, _, _, _, _, depth, volume, work, added,
      touched, limit, due, _, stiffness, place, spread) = part
     starts, items, radius = spread[0], spread[1], spread[4][0]
     pending, pending_list, pending_place, pending_count = spread[6], spread[7], spread[8], spread[9]
@@ -444,22 +445,24 @@ def _spread_face(face, part, count_moving):
     along = radius
     if length > 0.0:
         ux, uy, uz = ux / length, uy / length, uz / length
-        longest = 0.0
+        edges, longest = 0.0, 0.0
         for p, q in ((a, b), (b, c), (c, a)):
-            e2 = ((reference[p, 0] - reference[q, 0]) ** 2 + (reference[p, 1] - reference[q, 1]) ** 2
-                  + (reference[p, 2] - reference[q, 2]) ** 2)
-            longest = max(longest, np.sqrt(e2))
-        along = max(ALONG * radius, longest)
-    nx, ny, nz = normals[a, 0], normals[a, 1], normals[a, 2]
+            e = np.sqrt((reference[p, 0] - reference[q, 0]) ** 2
+                        + (reference[p, 1] - reference[q, 1]) ** 2
+                        + (reference[p, 2] - reference[q, 2]) ** 2)
+            edges += e
+            longest = max(longest, e)
+        along = max(ALONG * radius, 0.5 * (edges / 3.0 + longest))
     first, last = starts[a], starts[a + 1]
     total = 0.0
+    shares = np.empty(last - first)
     for e in range(first, last):
-        total += _weight(reference, normals, tributary, items[e], px, py, pz, ux, uy, uz, nx, ny,
-                         nz, length > 0.0, radius, along)
+        shares[e - first] = _weight(reference, tributary, items[e], px, py, pz, ux, uy, uz,
+                                    length > 0.0, radius, along)
+        total += shares[e - first]
     if total > 0.0:
         for e in range(first, last):
-            share = _weight(reference, normals, tributary, items[e], px, py, pz, ux, uy, uz, nx, ny,
-                            nz, length > 0.0, radius, along) / total
+            share = shares[e - first] / total
             if share > 0.0:
                 _deposit(items[e], share, energy, dv, delta, -1, faces, (0.0, 0.0, 0.0),
                          tributary, spacing, depth, volume, work, added, touched, limit, due,
@@ -482,12 +485,10 @@ def _spread_face(face, part, count_moving):
 
 
 @njit(cache=True, inline="always")
-def _weight(reference, normals, tributary, j, px, py, pz, ux, uy, uz, nx, ny, nz, directed, radius,
-            along):
-    """Vertex ``j``'s weight in a spread from ``p`` (:func:`_spread_face`):
-    none if its normal turns by more than 60 degrees from ``n``."""
-    if normals[j, 0] * nx + normals[j, 1] * ny + normals[j, 2] * nz < SPREAD_FACING:
-        return 0.0
+def _weight(reference, tributary, j, px, py, pz, ux, uy, uz, directed, radius, along):
+    """Vertex ``j``'s weight in a spread from ``p`` (:func:`_spread_face`;
+    the list it is on holds only vertices whose normals are within 60
+    degrees of its vertex's, :meth:`MeshSurface.spread_over`)."""
     dx, dy, dz = reference[j, 0] - px, reference[j, 1] - py, reference[j, 2] - pz
     d2 = dx * dx + dy * dy + dz * dz
     if directed:

@@ -62,14 +62,27 @@ def body_quantities(body, s, model):
     }
 
 
-def _spread_matrix(starts, items, weights):
+def _spread_matrix(surface, columns):
     """The (V, V) sparse matrix that spreads a per-vertex quantity of a worn
-    counter-part as its wear is spread (:meth:`meshwear.surfaces.MeshSurface.spread_over`):
-    column ``k`` holds vertex ``k``'s weights on the vertices it spreads to."""
-    from scipy.sparse import csc_matrix
+    counter-part as its wear is spread, evenly (:meth:`meshwear.surfaces.MeshSurface.spread_over`):
+    column ``k`` of ``columns`` (the vertices that hold some) holds vertex
+    ``k``'s weights on the vertices it spreads to; a vertex with none keeps
+    its own (1 on the diagonal)."""
+    from scipy.sparse import csc_matrix, diags
 
+    from ..surfaces.mesh import spread_weights
+
+    starts, items, radius = surface.spread[0], surface.spread[1], surface.spread[4][0]
     n = len(starts) - 1
-    return csc_matrix((weights, items, starts), shape=(n, n))
+    counts = np.diff(starts)
+    columns = columns[counts[columns] > 0]
+    k = np.repeat(columns, counts[columns])
+    j = np.concatenate([items[starts[c]:starts[c + 1]] for c in columns]) if len(columns) else \
+        np.zeros(0, np.int64)
+    weights = spread_weights(surface.reference_vertices, surface.tributary, k, j, radius)
+    weights /= np.bincount(k, weights, minlength=n)[k]
+    return (csc_matrix((weights, (j, k)), shape=(n, n))
+            + diags((counts == 0).astype(float)))
 
 
 def _matrix_quaternion(R):
@@ -116,8 +129,8 @@ def part_quantities(model, state, m):
                           np.where(weights[:, c] > 0.0, s.contact_state[slot, pairs], 0))
     if len(getattr(surface, "spread", ((),))[0]):
         # the forces spread as the wear is (the area each contact stands for)
-        starts, items, weights = surface.spread[0:3]
-        spread = _spread_matrix(starts, items, weights)
+        held = np.flatnonzero((normal_force != 0.0) | (np.abs(friction_force) > 0.0).any(axis=1))
+        spread = _spread_matrix(surface, held)
         normal_force = spread @ normal_force
         friction_force = spread @ friction_force
     counts = np.bincount(contact_state, minlength=3)

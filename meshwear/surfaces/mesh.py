@@ -7,6 +7,9 @@ its facets) counts as static in shape: its deviation from that surface,
 measured when the run is built, is checked against the active-set margin.
 """
 
+import itertools
+import logging
+
 import fcl
 import numpy as np
 
@@ -49,11 +52,27 @@ def bvh(vertices, faces):
 
 
 #: the spread of a worn surface whose vertices keep their shares
-NO_SPREAD = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros(1),
+NO_SPREAD = (np.zeros(0, np.int64), np.zeros(0, np.int32), np.zeros(0), np.zeros(0), np.zeros(1),
              np.zeros(0))
+
+def spread_weights(vertices, area, k, j, radius):
+    """The even spread's weight of vertex ``j`` from vertex ``k`` (arrays of
+    pairs): ``(1 - r²/R²)² A_j``, r their distance, R ``radius``, not yet
+    normalised (:meth:`MeshSurface.spread_over`)."""
+    d = vertices[j] - vertices[k]
+    r2 = np.einsum("ij,ij->i", d, d) / (radius * radius)
+    return np.where(r2 < 1.0, (1.0 - np.minimum(r2, 1.0)) ** 2, 0.0) * area[j]
+
 
 #: neighbours whose unworn normals are within 60 degrees share a spread
 SPREAD_FACING = 0.5
+
+#: a worn surface's spread lists hold at most this many entries (4 bytes
+#: each); a counter far finer than the bodies spreads over a shorter radius
+SPREAD_ENTRIES = 100_000_000
+
+#: spreading vertices whose lists are built at once
+SPREAD_CHUNK = 4096
 
 
 class MeshSurface(CounterSurface):
@@ -209,14 +228,18 @@ class MeshSurface(CounterSurface):
         ``finer_than`` (m) or more: a counter about as coarse as the bodies,
         or coarser, spreads a contact by its own faces; else those vertices
         spread. Sets ``spread``, ``(starts,
-        items, weights, self, radius, face_area)``: for each spreading vertex
+        items, [], self, radius, face_area)``: for each spreading vertex
         ``k`` the vertices within ``radius`` past its longest edge (as far as
         a spread from a point on its faces can reach) whose unworn normals
         are within 60 degrees of ``k``'s (not across a crease or through a
-        thin wall), with the even spread's weights from ``k``,
-        ``(1 - r²/R²)² A_j`` normalised (the written forces spread by them);
-        ``self`` each vertex's weight on itself (a spread vertex's
-        stiffness); each face's unworn area."""
+        thin wall; int32, 4 bytes an entry: a counter four times finer than
+        the bodies holds hundreds a vertex); ``self`` each vertex's weight on
+        itself in the even spread from it, :func:`spread_weights`
+        normalised (a spread vertex's
+        stiffness); each face's unworn area. Every other vertex has no list
+        and keeps its shares (its ``self`` 1). Lists of more than
+        :data:`SPREAD_ENTRIES` entries in all take a shorter radius, with a
+        notice."""
         self.spread = NO_SPREAD
         self._compiled = None
         if not radius > 0.0:
@@ -238,30 +261,57 @@ class MeshSurface(CounterSurface):
         longest = np.zeros(len(V))
         np.maximum.at(longest, edges.ravel(), np.repeat(lengths, 2))
         source = np.flatnonzero(spreads)
-        # (as far as a point on any face at the vertex could spread)
-        near = cKDTree(V).query_ball_point(V[source], radius + longest[source],
-                                           return_sorted=True)
-        k = np.repeat(source, [len(n) for n in near])
-        j = np.concatenate(near).astype(np.int64)
-        r2 = np.einsum("ij,ij->i", V[j] - V[k], V[j] - V[k]) / (radius * radius)
-        keep = np.einsum("ij,ij->i", normals[j], normals[k]) >= SPREAD_FACING
-        k, j = k[keep], j[keep]
-        weight = np.where(r2[keep] < 1.0, (1.0 - np.minimum(r2[keep], 1.0)) ** 2, 0.0) * area[j]
-        # every other vertex keeps its share (k = j, weight 1)
-        alone = np.flatnonzero(~spreads)
-        k, j = np.concatenate([k, alone]), np.concatenate([j, alone])
-        weight = np.concatenate([weight, np.ones(len(alone))])
-        order = np.lexsort((j, k))
-        k, items, weights = k[order], j[order].astype(np.int64), weight[order]
-        counts = np.bincount(k, minlength=len(V))
+        # the lists' size, each vertex's disc over its own area (before any
+        # query: a counter a hundred times finer than the bodies would ask
+        # for billions)
+        # the lists' size: each vertex's disc over its own area, sum of
+        # pi (R + l)² / A, a quadratic in R (before any query: a counter a
+        # hundred times finer than the bodies would ask for billions)
+        per = np.pi / np.maximum(area[source], 1e-300)
+        a, b, c = per.sum(), 2.0 * (per * longest[source]).sum(), (per * longest[source] ** 2).sum()
+        if a * radius * radius + b * radius + c > SPREAD_ENTRIES:
+            shorter = max((-b + np.sqrt(b * b + 4.0 * a * (SPREAD_ENTRIES - c))) / (2.0 * a), 0.0) \
+                if SPREAD_ENTRIES > c else 0.0
+            logging.getLogger("meshwear").warning(
+                "%s: its vertices are %.3g times finer than the bodies'; a contact's wear "
+                "spreads within %.3g m of it instead of %.3g m (memory), and may leave "
+                "tracks a body vertex apart: give the bodies a finer resolution "
+                "(docs/model.md, \"Worn counter-surfaces\")", self.name, finer_than /
+                (2.0 * float(np.median(mean_edge[spreads]))), shorter, radius)
+            if not shorter > 0.0:
+                return
+            radius = shorter
+        # (as far as a point on any face at the vertex could spread), in
+        # chunks: a query's lists of Python ints take 30 times the arrays
+        tree = cKDTree(V)
+        counts = np.zeros(len(V), np.int64)
+        self_weight = np.ones(len(V))
+        lists = []
+        for lo in range(0, len(source), SPREAD_CHUNK):
+            chunk = source[lo:lo + SPREAD_CHUNK]
+            near = tree.query_ball_point(V[chunk], radius + longest[chunk], return_sorted=True)
+            n = np.fromiter(map(len, near), np.int64, len(near))
+            j = np.fromiter(itertools.chain.from_iterable(near), np.int64, int(n.sum()))
+            k = np.repeat(chunk, n)
+            keep = np.einsum("ij,ij->i", normals[j], normals[k]) >= SPREAD_FACING
+            k, j = k[keep], j[keep]
+            lists.append(j.astype(np.int32))
+            counts[chunk] = np.bincount(k - chunk[0], minlength=chunk[-1] - chunk[0] + 1)[
+                chunk - chunk[0]]
+            weight = spread_weights(V, area, k, j, radius)
+            own = k == j
+            self_weight[chunk] = 0.0
+            self_weight[k[own]] = weight[own] / np.bincount(k - chunk[0], weight)[k[own] - chunk[0]]
+        # (source ascends, each list sorted; every other vertex has none and
+        # keeps its shares)
+        items = np.concatenate(lists)
+        del lists
         starts = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
-        weights = weights / np.repeat(np.add.reduceat(weights, starts[:-1]), counts)
-        self_weight = np.zeros(len(V))
-        np.add.at(self_weight, k[items == k], weights[items == k])
         tri = self.reference_vertices[self.faces]
         face_area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
                                          axis=1)
-        self.spread = (starts, items, weights, self_weight, np.array([float(radius)]), face_area)
+        self.spread = (starts, items, np.zeros(0), self_weight, np.array([float(radius)]),
+                       face_area)
 
     def attach(self, part):
         """Query and draw the worn geometry of ``part`` (a
