@@ -9,7 +9,8 @@ energy) is that density times its contact area, the one-point quadrature of
 the field over the area the wear divides by, scaled alike at every vertex so
 that the vertices carry the cells' total exactly (:func:`to_vertices`): the
 force over the area is the pressure at the point but for that one factor,
-the quadrature's error (5e-4 on the Hertz balls of docs/validation.md).
+the quadrature's error (5e-4 and 6e-4 on the two Hertz balls of
+docs/validation.md).
 
 (A vertex's share of the cells by the transposed gap weights, the vertex's
 hat function sampled at the cell centres, integrates the pressure over an
