@@ -458,7 +458,8 @@ def _refuse_before_refining(scene, built, unrefined):
     """Before any part is refined, where a mesh surface is to be: a body
     placed inside a surface, and a surface's resolution too fine for this
     machine from the bodies' coarse meshes (their vertices are among the
-    refined ones': :func:`meshwear.reach.refuse_early`), are refused without
+    refined ones', and the refined ones lie near the faces their resolution
+    refines: :func:`meshwear.reach.refuse_early`), are refused without
     the bodies' refinement first (a turning shaft's 80 000 faces take
     seconds). The deep-start check is made again once the parts are refined
     (their facets' sag)."""
@@ -471,10 +472,14 @@ def _refuse_before_refining(scene, built, unrefined):
     for j, (b, config) in enumerate(zip(coarse, scene.bodies)):
         _refuse_deep_start(scene, j, b, config, unrefined, surfaces.initial_planes(
             unrefined, b, b.initial_pose, 2.0 * b.radius)[0])
+    # (and the faces each body's resolution surely refines: near them the
+    # refined vertices are, where its coarse vertices need not be)
+    drawn = [reach.refined_faces(scene, config, b, unrefined)
+             for b, config in zip(coarse, scene.bodies)]
     for j in refined:
         s = scene.surfaces[j]
         try:
-            reach.refuse_early(scene, built[j], coarse, _periods(scene), s.resolution)
+            reach.refuse_early(scene, built[j], coarse, _periods(scene), s.resolution, drawn)
         except geometry.MeshError as err:
             raise SceneError(scene.source, _part_key(f"surface[{j}]", s), str(err)) from None
 
