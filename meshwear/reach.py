@@ -412,5 +412,13 @@ def _thin(points, origin, cell):
     """One point per occupied cube of side ``cell`` (m), at its centre (the
     points' cells counted from ``origin``)."""
     cell = max(cell, 2.0**-40 * float(np.ptp(points, axis=0).max(initial=0.0)))  # keys in int64
-    keys = np.unique(np.floor((points - origin) / cell).astype(np.int64), axis=0)
+    keys = np.floor((points - origin) / cell).astype(np.int64)
+    if len(keys) and keys.min() >= 0 and keys.max() < 2**21:
+        # three keys in one int64, in the same order (numpy's unique of rows
+        # sorts them as records: 11 s for a refined shaft's 10^7 points)
+        packed = np.unique((keys[:, 0] << 42) | (keys[:, 1] << 21) | keys[:, 2])
+        keys = np.stack([packed >> 42, (packed >> 21) & (2**21 - 1), packed & (2**21 - 1)],
+                        axis=1)
+    else:
+        keys = np.unique(keys, axis=0)
     return origin + (keys + 0.5) * cell
