@@ -85,20 +85,39 @@ class MeshSurface(CounterSurface):
         self.fitted_depth = None
         #: the :class:`meshwear.model.PartState` a worn one queries and draws
         self.part = None
-        self.bvh_geometry = bvh(self.vertices, self.faces)
-        self.bvh = fcl.CollisionObject(self.bvh_geometry, fcl.Transform())
+        self._bvh = None
+
+    @property
+    def bvh(self):
+        """Its fcl collision object for the broad phase (:meth:`_fcl`)."""
+        return self._fcl()[1]
+
+    @property
+    def bvh_geometry(self):
+        """The fcl BVH :attr:`bvh` holds."""
+        return self._fcl()[0]
+
+    def _fcl(self):
+        """Its fcl BVH and collision object, built at the first need from its
+        unworn faces: a surface refused, or refined into another, never
+        needs them (0.09 s for the gear pair's wheel, 18 600 faces)."""
+        if self._bvh is None:
+            geometry_ = bvh(getattr(self, "reference_vertices", self.vertices), self.faces)
+            self._bvh = (geometry_, fcl.CollisionObject(geometry_, fcl.Transform()))
+        return self._bvh
 
     @classmethod
-    def from_config(cls, config, mechanism=None):
+    def from_config(cls, config, mechanism=None, loaded=None):
         """A :class:`MeshSurface` from a validated ``[[surface]]`` of type
-        mesh (its mesh from a geom of the ``mechanism`` if it names one).
+        mesh (its mesh from a geom of the ``mechanism`` if it names one;
+        ``loaded``: the mesh files read so far, :func:`meshwear.geometry.load_part`).
 
         Raises
         ------
         geometry.MeshError
             For a mesh the engine cannot use; the caller adds the key.
         """
-        vertices, faces = geometry.load_part(config, mechanism)
+        vertices, faces = geometry.load_part(config, mechanism, loaded)
         return cls(config.name, vertices, faces, config.position, config.orientation,
                    config.rotation, config.path, config.smooth_normals)
 
