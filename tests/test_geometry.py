@@ -296,6 +296,40 @@ def test_refine_long_thin_triangles_economically():
     assert len(boundary.entities) == 1                           # one open strip, no holes
 
 
+@pytest.mark.parametrize("kind, kwargs, resolution", [
+    ("cylinder", dict(radius=0.003, height=0.012, sections=400), 5e-4),
+    ("cylinder", dict(radius=0.005, height=0.005, sections=256), 2.5e-4),
+    ("sphere", dict(radius=0.01, subdivisions=2), 1e-3),
+    ("box", dict(size=[0.01, 0.02, 0.003]), 7e-4),
+])
+def test_the_edges_of_the_faces_refined_bound_the_faces_made(kind, kwargs, resolution):
+    """Each edge of a face refined is cut in ceil(L / resolution) pieces at
+    least, each an edge of a face on either side: a third of their sum is
+    no more than the faces a refinement makes, all faces or the bottom's;
+    for a cylinder of many sections (caps of slivers) it is several times
+    what their area asks for."""
+    vertices, faces = geometry.primitive(kind, **kwargs)
+    bottom = geometry.face_normals(vertices, faces)[:, 2] < -0.5
+    for mask in (np.ones(len(faces), bool), bottom):
+        least = remesh._edge_faces(edge_lengths(vertices, faces), mask, resolution)
+        refined = remesh.refine(vertices, faces, resolution, face_mask=mask)[1]
+        assert len(refined) >= least
+        by_area = area(vertices, faces[mask]) / (np.sqrt(3.0) / 4.0 * resolution**2)
+        if kind == "cylinder" and kwargs["sections"] == 400:
+            assert least > 5.0 * by_area
+
+
+def test_a_fan_of_slivers_is_refused_from_its_edges_before_any_pass(monkeypatch):
+    """A pin of 20 000 sections refined to 0.5 mm: its caps' slivers make
+    at least 4/3 of 20 000 x 6 faces each where their area asks for 150;
+    refused before the first pass, not at the pass that makes too many."""
+    vertices, faces = geometry.primitive("cylinder", radius=0.003, height=0.012,
+                                         sections=20_000)
+    monkeypatch.setattr(remesh, "_bisect", lambda *a: pytest.fail("a pass was made"))
+    with pytest.raises(MeshError, match="needs at least"):
+        remesh.refine(vertices, faces, 5e-4, max_faces=100_000)
+
+
 def test_refine_leaves_fine_meshes_alone_and_checks_inputs():
     vertices, faces = geometry.primitive("sphere", radius=1.0, subdivisions=1)
     v, f = remesh.refine(vertices, faces, 10.0)
