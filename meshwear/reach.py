@@ -316,10 +316,12 @@ def _near_faces(points, normals, spacing, room, reach):
     whether a point ``q`` is within ``reach`` of a vertex of the refined
     mesh, sure from one drawn point ``p`` of normal ``n`` near it. That
     vertex lies within ``spacing`` of ``p`` in its face's plane, then moves
-    by ``snap``: it is at most sqrt(d_n² + (d_t + spacing)²) + snap from
-    ``q``, d_n and d_t the parts of ``q - p`` along ``n`` and across it (the
-    plain distance would ask for spacing + snap less than the reach: a
-    0.25 mm shaft's spacing 0.14 mm of a 0.19 mm reach)."""
+    by the snap, ``reach`` less ``room``: it is at most
+    sqrt(d_n² + (d_t + spacing)²) + snap from ``q``, d_n and d_t the parts
+    of ``q - p`` along ``n`` and across it, so within reach where the root
+    is within ``room`` (the plain distance would ask for spacing + snap
+    less than the reach: a 0.25 mm shaft's spacing 0.14 mm of a 0.19 mm
+    reach, 50 µm from the bore)."""
     from scipy.spatial import cKDTree
 
     index = cKDTree(points, balanced_tree=False, compact_nodes=False)
