@@ -49,6 +49,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import sparse
 from scipy.spatial import Delaunay, QhullError
+from threadpoolctl import threadpool_limits
 
 from . import halfspace
 from .cellfields import bilinear, signed_to_vertices, to_vertices
@@ -217,22 +218,27 @@ def _build_patch(patch, active, gap, r, area, hmin):
         spacing *= cells.max() / MAX_CELLS
         cells = np.ceil((hi - lo) / spacing).astype(int)
     cells = np.maximum(cells, 4)
-    try:
-        tri = Delaunay(coords)
-    except QhullError:
-        raise PatchError(f"the contact patch has too few vertices ({len(take)}) to span a "
-                         "grid; refine the body (resolution)") from None
     origin = lo + 0.5 * spacing
+    axes = [origin[j] + spacing * np.arange(cells[j]) for j in range(2)]
+    cx, cy = np.meshgrid(*axes, indexing="ij")
+    centres = np.column_stack([cx.ravel(), cy.ravel()])
+    # (scipy's barycentric transforms are a LAPACK call per triangle: with
+    # BLAS's threads, each waited for them on a busy machine, seconds for a
+    # thousand triangles where one thread takes milliseconds; a run limits
+    # them, but check and the first solve at rest come before it)
+    with threadpool_limits(limits=1, user_api="blas"):
+        try:
+            tri = Delaunay(coords)
+        except QhullError:
+            raise PatchError(f"the contact patch has too few vertices ({len(take)}) to span "
+                             "a grid; refine the body (resolution)") from None
+        simplex = tri.find_simplex(centres)
+        ok = simplex >= 0
+        T = tri.transform[simplex[ok]]
     old = patch.extra.get("old")
     patch.grid = halfspace.make_grid(tuple(cells), spacing, patch.extra["youngs"],
                                      patch.extra["poisson"])
     patch.origin = origin
-    axes = [origin[j] + spacing * np.arange(cells[j]) for j in range(2)]
-    cx, cy = np.meshgrid(*axes, indexing="ij")
-    centres = np.column_stack([cx.ravel(), cy.ravel()])
-    simplex = tri.find_simplex(centres)
-    ok = simplex >= 0
-    T = tri.transform[simplex[ok]]
     b = np.einsum("ijk,ik->ij", T[:, :2, :], centres[ok] - T[:, 2, :])
     bary = np.column_stack([b, 1.0 - b.sum(axis=1)])
     rows = np.repeat(np.flatnonzero(ok), 3)

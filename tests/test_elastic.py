@@ -274,6 +274,45 @@ def test_a_conforming_contact_is_refused(tmp_path):
         step(model, state)
 
 
+def test_the_patch_is_triangulated_on_one_blas_thread(tmp_path, monkeypatch):
+    """scipy's barycentric transforms of the patch's triangles are a LAPACK
+    call each: with BLAS's threads, each waited for them on a busy machine
+    (a 1 µm ball on the hertz_ball scene, refused as a conforming contact:
+    1.2 s in check after five idle seconds, where one thread takes 0.1 s;
+    seconds in a fresh process). A run keeps BLAS on one thread, but check
+    and the solve at rest come before it: the patch does it itself."""
+    from scipy.spatial import Delaunay
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    from meshwear import elastic
+
+    threads = []
+
+    def blas():
+        return max(info["num_threads"] for info in threadpool_info()
+                   if info["user_api"] == "blas")
+
+    class Spy:
+        def __init__(self, coords):
+            threads.append(blas())
+            self.made = Delaunay(coords)
+            self.simplices = self.made.simplices
+
+        def find_simplex(self, points):
+            threads.append(blas())
+            return self.made.find_simplex(points)
+
+        @property
+        def transform(self):
+            threads.append(blas())
+            return self.made.transform
+
+    monkeypatch.setattr(elastic, "Delaunay", Spy)
+    with threadpool_limits(limits=2, user_api="blas"):     # as many as a small machine has
+        initial_state(build_model(ball(tmp_path, duration=0.01)))
+    assert threads and set(threads) == {1}, threads
+
+
 def _gaps_twin(vertices, pose, planes, vertex_planes, active, area):
     """numpy twin of :func:`meshwear.kernels.elastic.gaps`."""
     from meshwear.surfaces.base import quaternion_matrix
