@@ -11,8 +11,12 @@ a spring per vertex. At each step, for each body and its counter-surface:
    regular grid in the tangent plane (cells of about one vertex's
    contact area, axes fixed to the body, the first along its path's
    stroke). The vertices' Delaunay triangles interpolate the gaps onto the
-   cells, linearly; the transposed weights take the cells' forces back to
-   the vertices, so the vertices carry exactly the solved load.
+   cells, linearly. Back on the vertices (:mod:`meshwear.cellfields`),
+   the grid's fields are read at each vertex's point, bilinearly between
+   the four cell centres around it: its pressure; its force is that
+   pressure times its contact area, all scaled alike so that the vertices
+   carry exactly the solved load (the same for the shear and the friction
+   energy).
 3. Normal. A guided body's load gives the load-controlled solve, its
    approach the body's move along its free axis (the load balance); a
    prescribed or fixed body's overlap gives the displacement-controlled
@@ -30,8 +34,9 @@ a spring per vertex. At each step, for each body and its counter-surface:
    surfaces. Any other relative
    motion (a turning disc, a circle) slides: Coulomb at every vertex,
    ``mu N_i`` against its slip velocity.
-5. Wear. Each vertex's energy (the cells' by the same transposed weights),
-   load and slip go through the wear law (:mod:`meshwear.kernels.laws`)
+5. Wear. Each vertex's energy (the cells' energy density at its point
+   times its area, scaled to the cells' total), load and slip go through
+   the wear law (:mod:`meshwear.kernels.laws`)
    and the vertex moves as in the Winkler kernel.
 
 The state of the solve (:class:`Patch`) is a cache: a run resumed from a
@@ -44,8 +49,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import sparse
 from scipy.spatial import Delaunay, QhullError
+from threadpoolctl import threadpool_limits
 
 from . import halfspace
+from .cellfields import bilinear, signed_to_vertices, to_vertices
 from .kernels.contact import FORCE as FORCE_SLOT
 from .kernels.contact import NO_CONTACT, SLIP, STICK
 from .kernels.elastic import gaps
@@ -83,6 +90,10 @@ UNIFORM = 1e-3
 SHEAR_CELLS = 64
 #: tangential solves kept for a periodic stroke to repeat
 CACHE_STEPS = 1024
+#: a vertex whose four cells around its point hold less than this share of
+#: slipping cells (of its pressed ones) dissipates nothing: its point sits
+#: on a stick cell, a slipping one touching the four's square at a corner
+SLIP_READING = 0.01
 #: two turning points whose shears differ by less than this fraction of the
 #: largest mu p are one (the solves' own tolerance is SHEAR_TOLERANCE)
 TURN_MATCH = 1e-3
@@ -122,6 +133,9 @@ class Patch:
     index: np.ndarray = None             # (k,) the vertices the triangles use
     coords: np.ndarray = None            # (k, 2) their tangent coordinates (m)
     weights: object = None               # sparse (cells, k): vertex gaps -> cells
+    interpolation: object = None         # sparse (k, cells): cells -> each vertex's point
+    areas: np.ndarray = None             # (k,) contact areas at the last normal solve (m^2)
+    point_pressure: np.ndarray = None    # (k,) the pressure at each vertex's point (Pa)
     allowed: np.ndarray = None           # cells inside the triangles
     heights: np.ndarray = None           # (k,) the gaps at the last normal solve
     approach: float = 0.0                # m: the last solve's approach on those gaps
@@ -143,7 +157,8 @@ class Patch:
     outside: np.ndarray = None           # the active set's other positions
     transposed: object = None            # weights.T, row-major
     loaded: np.ndarray = None            # the patch's vertices that carry load ...
-    transposed_loaded: object = None     # ... and their rows of transposed
+    transposed_loaded: object = None     # ... and their rows of transposed,
+    interpolation_loaded: object = None  # ... of interpolation
     written: np.ndarray = None           # the vertices the last step gave a contact
     counter: tuple = None                # (vertices, force): what a worn counter wears by
     window: tuple = None                 # the cells the tangential problem is solved on
@@ -203,22 +218,27 @@ def _build_patch(patch, active, gap, r, area, hmin):
         spacing *= cells.max() / MAX_CELLS
         cells = np.ceil((hi - lo) / spacing).astype(int)
     cells = np.maximum(cells, 4)
-    try:
-        tri = Delaunay(coords)
-    except QhullError:
-        raise PatchError(f"the contact patch has too few vertices ({len(take)}) to span a "
-                         "grid; refine the body (resolution)") from None
     origin = lo + 0.5 * spacing
+    axes = [origin[j] + spacing * np.arange(cells[j]) for j in range(2)]
+    cx, cy = np.meshgrid(*axes, indexing="ij")
+    centres = np.column_stack([cx.ravel(), cy.ravel()])
+    # (scipy's barycentric transforms are a LAPACK call per triangle: with
+    # BLAS's threads, each waited for them on a busy machine, seconds for a
+    # thousand triangles where one thread takes milliseconds; a run limits
+    # them, but check and the first solve at rest come before it)
+    with threadpool_limits(limits=1, user_api="blas"):
+        try:
+            tri = Delaunay(coords)
+        except QhullError:
+            raise PatchError(f"the contact patch has too few vertices ({len(take)}) to span "
+                             "a grid; refine the body (resolution)") from None
+        simplex = tri.find_simplex(centres)
+        ok = simplex >= 0
+        T = tri.transform[simplex[ok]]
     old = patch.extra.get("old")
     patch.grid = halfspace.make_grid(tuple(cells), spacing, patch.extra["youngs"],
                                      patch.extra["poisson"])
     patch.origin = origin
-    axes = [origin[j] + spacing * np.arange(cells[j]) for j in range(2)]
-    cx, cy = np.meshgrid(*axes, indexing="ij")
-    centres = np.column_stack([cx.ravel(), cy.ravel()])
-    simplex = tri.find_simplex(centres)
-    ok = simplex >= 0
-    T = tri.transform[simplex[ok]]
     b = np.einsum("ijk,ik->ij", T[:, :2, :], centres[ok] - T[:, 2, :])
     bary = np.column_stack([b, 1.0 - b.sum(axis=1)])
     rows = np.repeat(np.flatnonzero(ok), 3)
@@ -230,6 +250,7 @@ def _build_patch(patch, active, gap, r, area, hmin):
     patch.coords = coords
     patch.weights = weights
     patch.transposed = weights.T.tocsr()
+    patch.interpolation = bilinear(coords, origin, spacing, tuple(cells))
     patch.allowed = ok.reshape(cells)
     patch.pressure = None
     if old is not None:
@@ -349,7 +370,7 @@ def step(model, body, s, t, before, at_rest=False):
             patch.band = used / BAND_USE
             _drop_grid(patch)
             continue
-        _new_pressure(patch, solution, heights)
+        _new_pressure(patch, solution, heights, area[take])
         patch.spread = _spread(body, s, patch, n[take])
         if patch.spread > REFUSE_SPREAD:
             raise PatchError(
@@ -424,6 +445,24 @@ def step(model, body, s, t, before, at_rest=False):
             patch.extra["foundation"] = True
 
 
+def vertex_pressure(s):
+    """(n,) the pressure (Pa) at the points of the vertices that carry load
+    in the last step of a half-space body (state ``s``): the solved
+    pressure read bilinearly between the cell centres around each
+    (docs/outputs.md, ``pressure``); zero elsewhere. Its force is this
+    pressure times its contact area, scaled alike at every vertex by
+    ``P / sum(p_j A_j)``: the two differ by the quadrature's error only."""
+    out = np.zeros(len(s.wear_depth))
+    patch = s.elastic
+    if patch is not None and patch.written is not None and patch.point_pressure is not None:
+        on = patch.loaded
+        # (a contact narrower than a cell, which no vertex's point reads,
+        # is carried by the gap weights: its force over its area there)
+        out[patch.written] = np.where(patch.point_pressure[on] > 0.0, patch.point_pressure[on],
+                                      patch.forces[on] / patch.areas[on])
+    return out
+
+
 def counter_pairs(s):
     """Per slot, the (contact state, normal force) a worn counter-surface
     wears by after a half-space step (:func:`meshwear.model.wear_counters`):
@@ -449,12 +488,14 @@ def _tangential(model, patch, F, slip_v, mu, at_rest):
     of the patch's loaded vertices (their forces ``F``, slip velocities
     ``slip_v``) in the step: Cattaneo-Mindlin on the grid for a
     uniform slip along its first axis, else Coulomb at every vertex."""
-    T = patch.transposed_loaded
+    B, T = patch.interpolation_loaded, patch.transposed_loaded
+    areas, area_cell = patch.areas[patch.loaded], patch.grid.cell_area
     if not len(F) or at_rest:
         state = np.full(len(F), STICK, np.int8)
         friction = np.zeros((len(F), 3))
         if patch.shear is not None and len(F):
-            friction = -(T @ (patch.shear.ravel() * patch.grid.cell_area))[:, None] * patch.e1
+            friction = -signed_to_vertices(B, areas, T, patch.shear.ravel(), area_cell)[:, None] \
+                * patch.e1
         return np.zeros(len(F)), friction, state
     mean_v = slip_v.mean(axis=0)
     speed = float(np.linalg.norm(mean_v))
@@ -462,7 +503,6 @@ def _tangential(model, patch, F, slip_v, mu, at_rest):
     # slopes, and the slip in each one's plane differs by as much)
     uniform = np.abs(slip_v - mean_v).max() <= UNIFORM * speed + 1e-300
     along = abs(mean_v @ patch.e2) <= UNIFORM * speed + 1e-300
-    area_cell = patch.grid.cell_area
     if not (uniform and along and mu > 0.0):
         # sliding: Coulomb at every vertex against its own slip velocity
         patch.sliding = True
@@ -557,12 +597,31 @@ def _tangential(model, patch, F, slip_v, mu, at_rest):
                 patch.cache.clear()
             patch.cache[key] = (q, stick, cell_energy, new_key)
             patch.key = new_key
-        energy = T @ cell_energy.ravel()
     patch.shear = q
-    friction = -(T @ (q.ravel() * area_cell))[:, None] * patch.e1
-    stuck = T @ stick.ravel().astype(float)
-    share = T @ (patch.pressure > 0.0).ravel().astype(float)
-    return energy, friction, np.where(stuck > 0.5 * share, STICK, SLIP).astype(np.int8)
+    friction = -signed_to_vertices(B, areas, T, q.ravel(), area_cell)[:, None] * patch.e1
+    # the state at each vertex's point: stick where the stick cells around
+    # it weigh more than half of the pressed ones
+    stuck = B @ stick.ravel().astype(float)
+    share = B @ (patch.pressure > 0.0).ravel().astype(float)
+    state = np.where(stuck > 0.5 * share, STICK, SLIP).astype(np.int8)
+    if move != 0.0:
+        # each vertex's energy: the cells' energy density at its point times
+        # its area, the cells' total kept (the wear reads a vertex's energy
+        # over its area: the density at its point). A vertex on the stick
+        # zone's rim reads some (its area straddles the rim), whatever its
+        # state; one whose reading holds slipping cells only at a corner of
+        # its four does not (the majority's state there instead changed
+        # the fretting example's scar by a tenth in 2000 cycles and pitted
+        # its inner flank: docs/model.md, "In a run")
+        density = cell_energy.ravel() / area_cell
+        slipping = np.flatnonzero(share - stuck >= SLIP_READING * share)
+        energy[slipping] = to_vertices(B[slipping], areas[slipping], T[slipping], density,
+                                        area_cell)
+        if not energy.any():
+            # a slip zone no slipping vertex reads: its energy goes to the
+            # vertices around it
+            energy = to_vertices(B, areas, T, density, area_cell)
+    return energy, friction, state
 
 
 def _drop_grid(patch):
@@ -644,13 +703,22 @@ def _window(lo, hi, size, f):
     return tuple(out), min(factors)
 
 
-def _new_pressure(patch, solution, heights):
+def _new_pressure(patch, solution, heights, areas):
+    """Take the ``solution`` of the normal problem on ``heights`` (the
+    patch's vertices' gaps; ``areas`` their contact areas): the vertices'
+    pressure at their points and their forces (:mod:`meshwear.cellfields`), the
+    loaded vertices, the window of the tangential problem."""
     patch.pressure = solution.traction
     patch.heights = heights.copy()
     patch.approach = solution.approach
-    patch.forces = patch.transposed @ (solution.traction.ravel() * patch.grid.cell_area)
+    patch.areas = np.asarray(areas, float).copy()
+    pressure = solution.traction.ravel()
+    patch.point_pressure = patch.interpolation @ pressure
+    patch.forces = to_vertices(patch.interpolation, patch.areas, patch.transposed, pressure,
+                                patch.grid.cell_area)
     patch.loaded = np.flatnonzero(patch.forces > 0.0)
     patch.transposed_loaded = patch.transposed[patch.loaded]
+    patch.interpolation_loaded = patch.interpolation[patch.loaded]
     # the window of cells the tangential problem needs: the pressed ones
     pressed = np.argwhere(solution.traction > 0.0)
     if len(pressed):

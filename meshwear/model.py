@@ -326,9 +326,10 @@ def build_model(scene):
 
         mechanism = Mechanism(scene)
     built = []
+    loaded = {}         # the mesh files read, each once
     for j, s in enumerate(scene.surfaces):
         try:
-            built.append(surfaces.build_surface(s, mechanism))
+            built.append(surfaces.build_surface(s, mechanism, loaded))
         except geometry.MeshError as err:
             raise SceneError(scene.source, _part_key(f"surface[{j}]", s), str(err)) from None
     # the bodies are refined where they face the surfaces, then the mesh
@@ -339,8 +340,8 @@ def build_model(scene):
                 _ride(mechanism, surface, j, s.mechanism_body, 0.0)
     unrefined = surfaces.SurfaceSet(built)
     if mechanism is None:
-        _refuse_before_refining(scene, built, unrefined)
-    bodies = _build_bodies(scene, unrefined, mechanism)
+        _refuse_before_refining(scene, built, unrefined, loaded)
+    bodies = _build_bodies(scene, unrefined, mechanism, loaded=loaded)
     for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
         if getattr(s, "resolution", None) is not None and isinstance(surface,
                                                                      surfaces.MeshSurface):
@@ -473,11 +474,12 @@ def _ride(mechanism, surface, index, name, t):
     mechanism.surfaces.append((surface, index, name, surface.placement))
 
 
-def _refuse_before_refining(scene, built, unrefined):
+def _refuse_before_refining(scene, built, unrefined, loaded=None):
     """Before any part is refined, where a mesh surface is to be: a body
     placed inside a surface, and a surface's resolution too fine for this
     machine from the bodies' coarse meshes (their vertices are among the
-    refined ones': :func:`meshwear.reach.refuse_early`), are refused without
+    refined ones', and the refined ones lie near the faces their resolution
+    refines: :func:`meshwear.reach.refuse_early`), are refused without
     the bodies' refinement first (a turning shaft's 80 000 faces take
     seconds). The deep-start check is made again once the parts are refined
     (their facets' sag)."""
@@ -486,27 +488,32 @@ def _refuse_before_refining(scene, built, unrefined):
                and isinstance(surface, surfaces.MeshSurface)]
     if not refined:
         return
-    coarse = _build_bodies(scene, unrefined, coarse=True)
+    coarse = _build_bodies(scene, unrefined, coarse=True, loaded=loaded)
     for j, (b, config) in enumerate(zip(coarse, scene.bodies)):
         _refuse_deep_start(scene, j, b, config, unrefined, surfaces.initial_planes(
             unrefined, b, b.initial_pose, 2.0 * b.radius)[0])
+    # (and the faces each body's resolution surely refines: near them the
+    # refined vertices are, where its coarse vertices need not be)
+    drawn = [reach.refined_faces(scene, config, b, unrefined)
+             for b, config in zip(coarse, scene.bodies)]
     for j in refined:
         s = scene.surfaces[j]
         try:
-            reach.refuse_early(scene, built[j], coarse, _periods(scene), s.resolution)
+            reach.refuse_early(scene, built[j], coarse, _periods(scene), s.resolution, drawn)
         except geometry.MeshError as err:
             raise SceneError(scene.source, _part_key(f"surface[{j}]", s), str(err)) from None
 
 
-def _build_bodies(scene, surface_set, mechanism=None, coarse=False):
+def _build_bodies(scene, surface_set, mechanism=None, coarse=False, loaded=None):
     """The :class:`BodyModel` of every body; with ``coarse``, their meshes
-    as given (no ``resolution``: no mechanism either)."""
+    as given (no ``resolution``: no mechanism either); ``loaded``: the mesh
+    files read so far (:func:`meshwear.geometry.load_part`)."""
     bodies = []
     for j, b in enumerate(scene.bodies):
         if coarse:
             b = dataclasses.replace(b, resolution=None, resolution_reach=None)
         try:
-            bodies.append(_build_body(scene, j, b, surface_set, mechanism))
+            bodies.append(_build_body(scene, j, b, surface_set, mechanism, loaded))
         except geometry.MeshError as err:
             # the mesh loader names the mesh file; add the scene file and the key
             raise SceneError(scene.source, _part_key(f"body[{j}]", b), str(err)) from None
@@ -586,9 +593,9 @@ def _even_steps(n_steps, count):
     return np.unique(np.rint(np.linspace(0, n_steps, count)).astype(np.int64))
 
 
-def _build_body(scene, index, body, surface_set, mechanism=None):
+def _build_body(scene, index, body, surface_set, mechanism=None, loaded=None):
     key = f"body[{index}]"
-    vertices, faces = geometry.load_part(body, mechanism)
+    vertices, faces = geometry.load_part(body, mechanism, loaded)
     refinement = None
     if body.resolution is not None:
         vertices, faces, refinement = remesh.refine_part(

@@ -33,6 +33,12 @@ THIN_CELL = 0.25
 EARLY_POINTS = 2**19
 #: points of the sweep transformed at once (memory: 24 B each, a few times)
 CHUNK_POINTS = 2**20
+#: points drawn on a refined body's faces for the early refusal, at most,
+#: over the coarsest samples' instants (its coarse vertices can all lie
+#: beyond a surface's reach: a shaft's two rims, a bushing shorter than it)
+FACE_POINTS = 2**17
+#: the drawn points nearest a point of the surface that it is tried against
+FACE_NEIGHBOURS = 16
 
 
 def faces_to_refine(scene, body, vertices, faces, surface_set):
@@ -149,13 +155,15 @@ def _coarsest(scene, surface, bodies, window):
             for b in bodies]
 
 
-def refuse_early(scene, surface, bodies, periods, resolution):
+def refuse_early(scene, surface, bodies, periods, resolution, drawn=None):
     """Refuse a mesh surface's ``resolution`` (m) too fine for this machine
     before any part is refined, from the coarsest samples of ``bodies``'
     sweep (their meshes as given: the vertices of a refined body include
-    them, its margin is no smaller): :func:`_refuse_early`. Nothing to refuse
-    where :func:`surface_faces_to_refine` takes every face (its refinement
-    checks their whole area at once).
+    them, its margin is no smaller) and from ``drawn``, each body's
+    :func:`refined_faces` (None where it is not refined):
+    :func:`_refuse_early`. Nothing to refuse where
+    :func:`surface_faces_to_refine` takes every face (its refinement checks
+    their whole area at once).
 
     Raises
     ------
@@ -165,35 +173,171 @@ def refuse_early(scene, surface, bodies, periods, resolution):
         return
     low, high = surface.vertices.min(axis=0), surface.vertices.max(axis=0)
     _refuse_early(surface, _coarsest(scene, surface, bodies, _window(scene, periods)), low,
-                  high, resolution)
+                  high, resolution, drawn)
 
 
-def _refuse_early(surface, sweeps, low, high, resolution):
+def refined_faces(scene, config, body, surface_set):
+    """What body ``config``'s ``resolution`` surely makes of its mesh as
+    given (``body``, its :class:`meshwear.model.BodyModel` unrefined), for
+    :func:`refuse_early`; None without a resolution: ``(faces, spacing,
+    snap)``. ``faces`` (k, 3): the faces it refines whatever its passes do
+    (:func:`faces_to_refine`: all, those facing a surface, those wholly
+    within ``resolution_reach``); every point of one lies within
+    ``spacing`` (m) of a vertex of the refined mesh in the face's own plane
+    (a triangle with edges <= e has no point farther than e / sqrt 3 from
+    its corners; bisection and the flips between coplanar faces keep the
+    faces' planes); ``snap`` (m): how far such a vertex may then move onto
+    a sphere's or cylinder's true surface (the facets' depth under it)."""
+    if config.resolution is None:
+        return None
+    faces = body.faces
+    given = body.reference_vertices - body.origin          # the mesh's own frame
+    select = faces_to_refine(scene, config, given, faces, surface_set)
+    if callable(select):
+        faces = faces[select.surely(given, faces)]
+    elif select is not None:
+        faces = faces[select]
+    snap = 0.0
+    shape = config.shape
+    if shape is not None and shape.type in ("sphere", "cylinder") and len(faces):
+        # a facet's plane is |n . v| from the centre (a sphere) or the axis
+        # (a cylinder's side; its caps' vertices move only on the rim)
+        normals = geometry.face_normals(given, faces)
+        depth = shape.radius - np.abs(np.einsum("ij,ij->i", normals, given[faces[:, 0]]))
+        if shape.type == "cylinder":
+            depth = depth[np.abs(normals[:, 2]) < geometry.SIDE]
+        snap = float(max(depth.max(initial=0.0), 0.0))
+    return faces, float(config.resolution) / np.sqrt(3.0), snap
+
+
+def _reach_at_least(sweeps):
+    """A lower bound (m) of the reach :func:`surface_faces_to_refine` finds
+    from the bodies of ``sweeps`` (``(body, margin, moves)`` at the coarsest
+    samples) or finer ones holding their vertices: each body's margin and
+    half its largest step between instants, and that step is at least the
+    one of these vertices at the coarsest samples when it stops there, and
+    more than half the margin when it doubles them (the step over one
+    interval of n is at most twice that over one of 2n)."""
+    return max(margin + 0.5 * min(_largest_step(_early_vertices(b, c), M, c), 0.5 * margin)
+               for b, margin, (M, c) in sweeps)
+
+
+def _early_vertices(body, instants):
+    """``body``'s vertices, every k-th of them beyond :data:`EARLY_POINTS`
+    over ``instants``: what the early refusal looks at (the step and the
+    reach of fewer vertices are no larger)."""
+    vertices = body.reference_vertices
+    return vertices[::max(1, -(-len(vertices) * len(instants) // EARLY_POINTS))]
+
+
+def _refuse_early(surface, sweeps, low, high, resolution, drawn=None):
     """Refuse ``resolution`` from the coarsest samples of the bodies' sweeps
-    (``(body, margin, moves)``): the surface within the smallest margin of
-    their vertices at those instants (of :data:`EARLY_POINTS` at most) is
-    within reach of the finer samples too (the instants are among theirs),
-    so refined whatever the passes do."""
+    (``(body, margin, moves)``): the surface within :func:`_reach_at_least`
+    of their vertices at those instants (of :data:`EARLY_POINTS` at most)
+    is within reach of the finer samples too (the instants are among
+    theirs), so refined whatever the passes do. So is the surface near a
+    refined body's faces (``drawn``: each body's :func:`refined_faces` or
+    None): :func:`_near_faces`."""
+    found = _early_within(sweeps, low, high, drawn)
+    if found is None:
+        return
+    within, lo, hi = found
+    tri = surface.vertices[surface.faces]
+    faces = surface.faces[np.all((tri.max(axis=1) >= lo) & (tri.min(axis=1) <= hi), axis=1)]
+    area = remesh.sampled_area(surface.vertices, faces, within, np.random.default_rng(0))
+    remesh.check_area(area, resolution)
+
+
+def _early_within(sweeps, low, high, drawn=None):
+    """``(within, lo, hi)`` of :func:`_refuse_early`: ``within(points)``
+    ((k,) bool) says which points are surely within the reach of the bodies'
+    sweep; none lies outside the box ``lo`` .. ``hi``. None if no part of
+    the sweep comes near the box ``low`` .. ``high``."""
     from scipy.spatial import cKDTree
 
-    near = min(margin for _, margin, _ in sweeps)
-    clouds = []
-    for b, _, (M, c) in sweeps:
-        vertices = b.reference_vertices
-        vertices = vertices[::max(1, -(-len(vertices) * len(c) // EARLY_POINTS))]
-        clouds.append(_swept_cloud(vertices, M, c, low - near, high + near, None)[0])
+    near = _reach_at_least(sweeps)
+    drawn = drawn or [None] * len(sweeps)
+    clouds, faces_near = [], []
+    for (b, _, (M, c)), made in zip(sweeps, drawn):
+        clouds.append(_swept_cloud(_early_vertices(b, c), M, c, low - near, high + near,
+                                   None)[0])
+        if made is not None:
+            faces_near.append(_drawn_cloud(b.reference_vertices, *made, M, c, low - near,
+                                           high + near, near))
     cloud = np.concatenate(clouds)
-    if not len(cloud):
-        return
-    index = cKDTree(cloud, balanced_tree=False, compact_nodes=False)
-    tri = surface.vertices[surface.faces]
-    lo, hi = cloud.min(axis=0) - near, cloud.max(axis=0) + near
-    faces = surface.faces[np.all((tri.max(axis=1) >= lo) & (tri.min(axis=1) <= hi), axis=1)]
-    area = remesh.sampled_area(
-        surface.vertices, faces,
-        lambda points: index.query(points, distance_upper_bound=near)[0] <= near,
-        np.random.default_rng(0))
-    remesh.check_area(area, resolution)
+    drawn_cloud = [np.concatenate(parts) for parts in zip(*faces_near)] if faces_near else None
+    every = cloud if drawn_cloud is None else np.concatenate([cloud, drawn_cloud[0]])
+    if not len(every):
+        return None
+    index = cKDTree(cloud, balanced_tree=False, compact_nodes=False) if len(cloud) else None
+    near_faces = _near_faces(*drawn_cloud, near) if drawn_cloud and len(drawn_cloud[0]) else None
+
+    def within(points):
+        out = np.zeros(len(points), bool)
+        if index is not None:
+            out |= index.query(points, distance_upper_bound=near)[0] <= near
+        if near_faces is not None:
+            out |= near_faces(points)
+        return out
+
+    return within, every.min(axis=0) - near, every.max(axis=0) + near
+
+
+def _drawn_cloud(vertices, faces, spacing, snap, M, c, low, high, reach):
+    """Points drawn by area on a body's ``faces`` (of ``vertices``, its
+    frame; :data:`FACE_POINTS` over all the instants of ``M``, ``c``), at
+    each instant, with their faces' normals there, within the box ``low`` ..
+    ``high``: ``(points, normals, spacing, room)``, each point's
+    ``spacing`` (m) and the reach left once the refined vertex near it
+    has moved by ``snap`` (``room``, m)."""
+    per = max(1, FACE_POINTS // len(c))
+    areas = 0.5 * geometry._doubled_areas(vertices, faces)
+    total = float(areas.sum())
+    empty = np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0)
+    if not (total > 0.0 and reach > snap):
+        return empty
+    rng = np.random.default_rng(0)
+    pick = np.minimum(np.searchsorted(np.cumsum(areas), rng.random(per) * total),
+                      len(faces) - 1)
+    u, v = rng.random((2, per))
+    s = np.sqrt(u)[:, None]
+    tri = vertices[faces[pick]]
+    drawn = (1.0 - s) * tri[:, 0] + s * ((1.0 - v)[:, None] * tri[:, 1] + v[:, None] * tri[:, 2])
+    normals = geometry.face_normals(vertices, faces[pick])
+    points = (np.matmul(drawn, M) + c[:, None, :]).reshape(-1, 3)
+    turned = np.matmul(normals, M).reshape(-1, 3)
+    keep = np.all((points >= low) & (points <= high), axis=1)
+    k = int(keep.sum())
+    return points[keep], turned[keep], np.full(k, spacing), np.full(k, reach - snap)
+
+
+def _near_faces(points, normals, spacing, room, reach):
+    """``within(q)`` for the drawn points of refined faces (:func:`_drawn_cloud`):
+    whether a point ``q`` is within ``reach`` of a vertex of the refined
+    mesh, sure from one drawn point ``p`` of normal ``n`` near it. That
+    vertex lies within ``spacing`` of ``p`` in its face's plane, then moves
+    by the snap, ``reach`` less ``room``: it is at most
+    sqrt(d_n² + (d_t + spacing)²) + snap from ``q``, d_n and d_t the parts
+    of ``q - p`` along ``n`` and across it, so within reach where the root
+    is within ``room`` (the plain distance would ask for spacing + snap
+    less than the reach: a 0.25 mm shaft's spacing 0.14 mm of a 0.19 mm
+    reach, 50 µm from the bore)."""
+    from scipy.spatial import cKDTree
+
+    index = cKDTree(points, balanced_tree=False, compact_nodes=False)
+    k = min(FACE_NEIGHBOURS, len(points))
+
+    def within(q):
+        _, found = index.query(q, k=k, distance_upper_bound=reach)
+        found = found.reshape(len(q), k)
+        valid = found < len(points)
+        at = np.where(valid, found, 0)
+        d = q[:, None, :] - points[at]
+        normal = np.einsum("ijk,ijk->ij", d, normals[at])
+        across = np.sqrt(np.maximum(np.einsum("ijk,ijk->ij", d, d) - normal**2, 0.0))
+        return np.any(valid & (normal**2 + (across + spacing[at])**2 <= room[at]**2), axis=1)
+
+    return within
 
 
 def _within(index, points, bound):
@@ -270,5 +414,13 @@ def _thin(points, origin, cell):
     """One point per occupied cube of side ``cell`` (m), at its centre (the
     points' cells counted from ``origin``)."""
     cell = max(cell, 2.0**-40 * float(np.ptp(points, axis=0).max(initial=0.0)))  # keys in int64
-    keys = np.unique(np.floor((points - origin) / cell).astype(np.int64), axis=0)
+    keys = np.floor((points - origin) / cell).astype(np.int64)
+    if len(keys) and keys.min() >= 0 and keys.max() < 2**21:
+        # three keys in one int64, in the same order (numpy's unique of rows
+        # sorts them as records: 11 s for a refined shaft's 10^7 points)
+        packed = np.unique((keys[:, 0] << 42) | (keys[:, 1] << 21) | keys[:, 2])
+        keys = np.stack([packed >> 42, (packed >> 21) & (2**21 - 1), packed & (2**21 - 1)],
+                        axis=1)
+    else:
+        keys = np.unique(keys, axis=0)
     return origin + (keys + 0.5) * cell

@@ -88,9 +88,11 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=None, return_m
     max_faces : int, optional
         Refuse (MeshError) rather than build a larger mesh: before a pass
         when the area surely refined alone needs more faces (a triangle with
-        edges <= ``resolution`` covers sqrt(3)/4 resolution² at most), else
-        as soon as a pass makes more. Default: :func:`face_limit` (this
-        machine's available memory, at most :data:`MAX_FACES`).
+        edges <= ``resolution`` covers sqrt(3)/4 resolution² at most), or
+        the edges of the faces surely refined do (:func:`_edge_faces`: a fan
+        of slivers), else as soon as a pass makes more. Default:
+        :func:`face_limit` (this machine's available memory, at most
+        :data:`MAX_FACES`).
     return_mask : bool
         Also return which faces come from selected ones.
 
@@ -117,11 +119,13 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=None, return_m
         if select is not None and len(F) > first_count:
             mask = select(V, F)
         # before each pass: the area surely refined needs this many faces at
-        # least (a fixed selection's is known before the first; one made anew
-        # each pass knows more of it as its faces shrink to the part within reach)
-        if select is not None or len(F) == first_count:
-            check_area(_surely_refined_area(V, F, mask, select, rng), resolution, max_faces, why)
+        # least, and so do the edges of the faces refined whole (a fixed
+        # selection's are known before the first; one made anew each pass
+        # knows more of them as its faces shrink to the part within reach)
         lengths = _edge_lengths(V, F)
+        if select is not None or len(F) == first_count:
+            area, whole = _surely_refined_area(V, F, mask, select, rng)
+            check_area(area, resolution, max_faces, why, _edge_faces(lengths, whole, resolution))
         need = mask & (lengths.max(axis=1) > resolution)
         if not need.any():
             # a mesh it refined comes out in space order; one it did not, as it was
@@ -162,37 +166,57 @@ def refine(vertices, faces, resolution, face_mask=None, max_faces=None, return_m
 AREA_SAMPLES = 4096
 
 
-def check_area(area, resolution, max_faces=None, why="the limit asked"):
+def check_area(area, resolution, max_faces=None, why="the limit asked", faces=0.0):
     """Refuse (MeshError) to refine ``area`` (m²) to ``resolution`` (m) when
     it needs more than ``max_faces`` faces (default: :func:`face_limit`): a
     triangle with edges <= ``resolution`` covers sqrt(3)/4 resolution² at
-    most, so no refinement of it makes fewer."""
+    most, so no refinement of it makes fewer; nor fewer than ``faces``, a
+    bound known otherwise (:func:`_edge_faces`)."""
     if max_faces is None:
         max_faces, why = face_limit()
     cell = _LARGEST_UNIT_TRIANGLE * resolution**2     # 0.0 for a subnormal resolution
-    least = area / cell if cell > 0.0 else float("inf")
+    least = max(area / cell if cell > 0.0 else float("inf"), faces)
     if not least <= max_faces:
         raise MeshError(f"refining to resolution {resolution:g} m needs at least {least:.3g} "
                         f"faces, more than {max_faces} ({why}); give a coarser resolution")
 
 
 def _surely_refined_area(V, F, mask, select, rng):
-    """Area (m²) that the refinement refines whatever its passes do: the
-    selected faces' (a fixed selection), else what the selection says it
-    surely refines: the faces of its ``surely(V, F)``, or the part of the
-    selected faces where its ``within(points)`` holds (:func:`sampled_area`:
-    a thin band across big faces is missed at first, and seen once the
-    passes have cut them near it)."""
+    """``(area, faces)``: the area (m²) that the refinement refines whatever
+    its passes do and the faces ((m,) bool) it refines whole: the selected
+    faces (a fixed selection), else what the selection says it surely
+    refines: the faces of its ``surely(V, F)``, or the part of the selected
+    faces where its ``within(points)`` holds (:func:`sampled_area`: a thin
+    band across big faces is missed at first, and seen once the passes have
+    cut them near it; no face whole)."""
     if select is None:
-        return 0.5 * float(_doubled_areas(V, F[mask]).sum())
-    area = 0.0
+        return 0.5 * float(_doubled_areas(V, F[mask]).sum()), mask
+    area, whole = 0.0, np.zeros(len(F), bool)
     surely = getattr(select, "surely", None)
     if surely is not None:
-        area = 0.5 * float(_doubled_areas(V, F[surely(V, F)]).sum())
+        whole = surely(V, F)
+        area = 0.5 * float(_doubled_areas(V, F[whole]).sum())
     within = getattr(select, "within", None)
     if within is not None:
         area = max(area, sampled_area(V, F[mask], within, rng))
-    return area
+    return area, whole
+
+
+def _edge_faces(lengths, whole, resolution):
+    """Faces a conforming refinement makes at least, from the edges
+    (``lengths`` (m, 3) m) of the faces ``whole`` ((m,) bool) that it
+    refines to ``resolution`` (m): such an edge of length L is cut in
+    ceil(L / resolution) pieces at least; each piece is an edge of a face
+    on either side of it (no T-junctions), and a face has three edges.
+    Counted from each face's side (an edge between a face refined whole and
+    another counts one piece on the other's: fewer, still a bound). A
+    cylinder's cap of n slivers, or its side of n facets, makes about
+    4/3 n L / resolution faces where its area asks for a few hundred (a
+    shaft of 100 000 sections at 0.25 mm: 5.5 million, refused after 67 s
+    at the pass that made more than the limit)."""
+    with np.errstate(over="ignore"):
+        pieces = np.ceil(lengths[whole] / resolution).sum()
+    return float(pieces + 3.0 * np.count_nonzero(~whole)) / 3.0
 
 
 def sampled_area(vertices, faces, within, rng):

@@ -872,3 +872,44 @@ def test_a_worn_surface_is_refined_only_where_a_body_reaches_it(tmp_path):
     assert reached.sum() > 50
     assert np.all(edges[reached] <= 5e-4 * (1 + 1e-9)), "every face a body reaches is refined"
     assert edges[~reached].max() > 4e-3, "faces nothing reaches keep their size"
+
+
+@pytest.mark.parametrize("stem,share", [("shaft_in_worn_bushing", 0.5),
+                                        ("cylinder_on_worn_flat", 0.5)])
+def test_the_early_refusal_counts_only_surface_the_refined_bodies_reach(stem, share):
+    """Before any part is refined, a worn surface's resolution is refused
+    from the surface within a lower bound of the reach of the bodies' sweep
+    (meshwear.reach.refuse_early): that of their vertices as given, and of
+    points drawn on the faces their resolution refines, allowing for how
+    far the refined vertices may lie from those points. Every point of the
+    surface it counts is one the refined bodies' sweep reaches
+    (surface_faces_to_refine, after the bodies are refined), and it counts
+    at least ``share`` of those: a turning shaft's coarse vertices lie on
+    its rims, beyond the shorter bushing's bore, and counted none of it
+    (the refusal then waited for the shaft's 81 550 faces)."""
+    from meshwear import geometry, model as model_, reach, surfaces
+
+    scene = load_scene(f"examples/{stem}.toml")
+    built = [surfaces.build_surface(s) for s in scene.surfaces]
+    unrefined = surfaces.SurfaceSet(built)
+    coarse = model_._build_bodies(scene, unrefined, coarse=True)
+    drawn = [reach.refined_faces(scene, c, b, unrefined) for b, c in zip(coarse, scene.bodies)]
+    refined = model_._build_bodies(scene, unrefined)
+    surface, periods = built[0], model_._periods(scene)
+    sweeps = reach._coarsest(scene, surface, coarse, reach._window(scene, periods))
+    low, high = surface.vertices.min(axis=0), surface.vertices.max(axis=0)
+    early = reach._early_within(sweeps, low, high, drawn)[0]
+    reached = reach.surface_faces_to_refine(scene, surface, refined, periods, 1.0).within
+    rng = np.random.default_rng(1)
+    V, F = surface.vertices, surface.faces
+    areas = geometry._doubled_areas(V, F)
+    pick = np.minimum(np.searchsorted(np.cumsum(areas), rng.random(100_000) * areas.sum()),
+                      len(F) - 1)
+    u, v = rng.random((2, len(pick)))
+    s = np.sqrt(u)[:, None]
+    tri = V[F[pick]]
+    points = (1 - s) * tri[:, 0] + s * ((1 - v)[:, None] * tri[:, 1] + v[:, None] * tri[:, 2])
+    counted, real = early(points), reached(points)
+    assert real.sum() > 1000
+    assert not np.any(counted & ~real), "the early count is a lower bound"
+    assert counted.sum() >= share * real.sum()

@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from ..elastic import vertex_pressure
 from ..kernels.contact import FORCE, rotation_entries
 from ..surfaces import contact_areas, slot_normals, vertex_feet
 
@@ -29,7 +30,8 @@ def body_quantities(body, s, model):
     """Per-vertex fields and totals of one body, for recorders.
 
     The pressure of a vertex is its normal force over its contact area on
-    each counter-surface, summed.
+    each counter-surface, summed; with the half-space contact the solved
+    pressure at its point (:func:`meshwear.elastic.vertex_pressure`).
 
     Returns
     -------
@@ -40,12 +42,17 @@ def body_quantities(body, s, model):
     R = np.array(rotation_entries(s.pose[3:7])).reshape(3, 3)
     normal_force = s.normal_force.sum(axis=0)
     friction_force = s.tangential[:, :, FORCE, :].sum(axis=0)
-    pressure = np.zeros(len(s.wear_depth))
-    for j, normal in enumerate(slot_normals(model, s)):
-        loaded = s.normal_force[j] > 0.0
-        if loaded.any():
-            area = contact_areas(body, s, normal)
-            pressure[loaded] += s.normal_force[j][loaded] / area[loaded]
+    if s.elastic is not None:
+        # the grid's pressure at each vertex's point, not its force over its
+        # area (docs/model.md, "In a run")
+        pressure = vertex_pressure(s)
+    else:
+        pressure = np.zeros(len(s.wear_depth))
+        for j, normal in enumerate(slot_normals(model, s)):
+            loaded = s.normal_force[j] > 0.0
+            if loaded.any():
+                area = contact_areas(body, s, normal)
+                pressure[loaded] += s.normal_force[j][loaded] / area[loaded]
     return {
         "points": s.pose[0:3] + s.vertices @ R.T,
         "origin": s.pose[0:3] + R @ body.origin,

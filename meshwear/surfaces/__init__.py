@@ -18,9 +18,10 @@ from .plane import Plane
 TYPES = {"plane": Plane, "cylinder": Cylinder, "sphere": Sphere, "mesh": MeshSurface}
 
 
-def build_surface(config, mechanism=None):
+def build_surface(config, mechanism=None, loaded=None):
     """The counter-surface of a validated ``[[surface]]`` table (a mesh one
-    may take its mesh from a geom of the ``mechanism``).
+    may take its mesh from a geom of the ``mechanism``; ``loaded``: the mesh
+    files read so far, :func:`meshwear.geometry.load_part`).
 
     Raises
     ------
@@ -28,7 +29,7 @@ def build_surface(config, mechanism=None):
         For a mesh the engine cannot use; the caller adds the key.
     """
     if config.type == "mesh":
-        return MeshSurface.from_config(config, mechanism)
+        return MeshSurface.from_config(config, mechanism, loaded)
     return TYPES[config.type].from_config(config)
 
 
