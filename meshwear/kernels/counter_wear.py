@@ -50,11 +50,11 @@ part : tuple
     the step falls per unit of its own depth (docs/model.md, "Long
     durations"), then where each vertex is in the lagging list (V,) int64,
     -1 when it does not lag, so that one that moves leaves it at once,
-    and its ``spread``, a tuple: ``starts`` (V + 1,) int64, ``items`` int64
-    and ``weights`` float (vertex ``k``'s share of a contact's wear goes on
-    to vertex ``items[e]`` by ``weights[e]`` for ``e`` in
-    ``starts[k]:starts[k + 1]``; they add up to 1), each vertex's weight on
-    itself (V,), the spread's radius (1,) (m), each face's unworn area (F,),
+    and its ``spread``, a tuple: ``starts`` (V + 1,) int64 and ``items``
+    int32 (a face whose first corner ``k`` has more than one entry,
+    ``items[starts[k]:starts[k + 1]]``, spreads over them), an empty
+    array, each vertex's weight on itself in an even spread (V,), the
+    spread's radius (1,) (m), each face's unworn area (F,),
     then what waits to be spread: ``pending`` (9, F) (the volume, m³, and
     energy, J, put on each face since it last spread, and the pairs'
     penetration, directions of sliding and contact points in the counter's
@@ -93,7 +93,7 @@ NO_PART = (np.array([-1.0, 0.0]), np.zeros((0, 3), np.int64), np.zeros((0, 3)), 
            np.zeros((0, 3)), np.zeros((0, 4, 4)), np.zeros(0), np.zeros(0), np.zeros(0),
            np.zeros(0), np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.int64),
            np.zeros(1, np.int64), np.zeros(0), np.zeros(0, np.int64),
-           (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0),
+           (np.zeros(0, np.int64), np.zeros(0, np.int32), np.zeros(0), np.zeros(0),
             np.zeros(1), np.zeros(0), np.zeros((9, 0)), np.zeros(0, np.int64),
             np.zeros(0, np.int64), np.zeros(1, np.int64)))
 

@@ -275,16 +275,15 @@ class MeshSurface(CounterSurface):
         on average shorter than ``radius``, have a median mean edge of
         ``finer_than`` (m) or more: a counter about as coarse as the bodies,
         or coarser, spreads a contact by its own faces; else those vertices
-        spread. Sets ``spread``, ``(starts,
-        items, [], self, radius, face_area)``: for each spreading vertex
-        ``k`` the vertices within ``radius`` past its longest edge (as far as
-        a spread from a point on its faces can reach) whose unworn normals
-        are within 60 degrees of ``k``'s (not across a crease or through a
-        thin wall; int32, 4 bytes an entry: a counter four times finer than
-        the bodies holds hundreds a vertex); ``self`` each vertex's weight on
-        itself in the even spread from it, :func:`spread_weights`
-        normalised (a spread vertex's
-        stiffness); each face's unworn area. Every other vertex has no list
+        spread. Sets ``spread``, ``(starts, items, [], self, radius,
+        face_area)``: for each spreading vertex ``k`` the vertices within
+        ``radius`` past its longest edge (as far as a spread from a point on
+        its faces can reach) whose unworn normals are within 60 degrees of
+        ``k``'s (not across a crease or through a thin wall; int32, 4 bytes
+        an entry: a counter four times finer than the bodies holds hundreds
+        a vertex); ``self`` each vertex's weight on itself in the even
+        spread from it (:func:`spread_weights`, normalised: a spread
+        vertex's stiffness); each face's unworn area. Every other vertex has no list
         and keeps its shares (its ``self`` 1). Lists of more than
         :data:`SPREAD_ENTRIES` entries in all take a shorter radius, with a
         notice."""
@@ -309,9 +308,6 @@ class MeshSurface(CounterSurface):
         longest = np.zeros(len(V))
         np.maximum.at(longest, edges.ravel(), np.repeat(lengths, 2))
         source = np.flatnonzero(spreads)
-        # the lists' size, each vertex's disc over its own area (before any
-        # query: a counter a hundred times finer than the bodies would ask
-        # for billions)
         # the lists' size: each vertex's disc over its own area, sum of
         # pi (R + l)² / A, a quadratic in R (before any query: a counter a
         # hundred times finer than the bodies would ask for billions)
