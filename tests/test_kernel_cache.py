@@ -172,3 +172,54 @@ def test_a_damaged_entry_is_compiled_anew_with_one_line(tmp_path, damage):
     assert lines and all("compiled anew" in line or "compiling it anew" in line
                          for line in lines), err
     assert _totals(folder) == (0, ["20", "20.0"], "")
+
+
+NESTED = """
+import sys
+
+import numpy as np
+from numba import prange
+
+{import_line}
+
+
+@njit(cache=True, parallel=True)
+def inner(a):
+    out = np.empty(a.shape[0])
+    for i in prange(a.shape[0]):
+        out[i] = 2.0 * a[i]
+    return out
+
+
+@njit(cache=True)
+def outer(a):
+    return inner(a).sum()
+
+
+a = np.ones(100_000)
+print(inner(a).sum() if sys.argv[1] == "inner" else outer(a))
+"""
+
+
+@pytest.mark.parametrize("guarded", [False, True])
+def test_a_cached_kernel_calling_a_threaded_one_runs_from_the_cache(tmp_path, guarded):
+    """The crash of issue 41. A process compiles and caches a ``parallel=True``
+    kernel; a second loads it from the cache, compiles a kernel that calls
+    it and caches that; a third loads the caller and, nothing having started
+    numba's threading layer there, dies with SIGSEGV at its parallel region
+    (numba#8578, #9938). The guarded cache starts the layer when it loads a
+    kernel (``jit._threads_up``)."""
+    line = ("from meshwear.kernels.jit import njit" if guarded else "from numba import njit")
+    script = tmp_path / "nested.py"
+    script.write_text(NESTED.format(import_line=line))
+    env = dict(os.environ, PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(tmp_path / "cache"),
+               NUMBA_NUM_THREADS="2")
+    runs = [subprocess.run([sys.executable, str(script), which], capture_output=True,
+                           text=True, env=env, timeout=300)
+            for which in ("inner", "outer", "outer")]
+    for done in runs[:2]:
+        assert done.returncode == 0 and done.stdout.split() == ["200000.0"]
+    if guarded:
+        assert runs[2].returncode == 0 and runs[2].stdout.split() == ["200000.0"]
+    else:
+        assert runs[2].returncode == -11, "numba's own cache did not crash: the test shows nothing"

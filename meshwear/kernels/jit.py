@@ -138,6 +138,28 @@ def _acquire(path):
         time.sleep(0.05)
 
 
+def _threads_up():
+    """Start numba's threading layer (once), before any kernel is loaded
+    from the cache. Starting it gives LLVM the layer's symbols (the parallel
+    scheduler's entry points); a kernel whose machine code calls them, linked
+    before they are given, calls address 0. A kernel that is not
+    ``parallel=True`` itself but calls one that is (the step loop calls the
+    threaded contact and counter kernels) does not start it when loaded if
+    it was compiled in a process that loaded that threaded kernel from the
+    cache: its saved library does not carry the callee's start-up
+    (numba#8578, #9938; numba PR #9950, not released). A process that
+    loads it first then dies with SIGSEGV at its first parallel region,
+    every run, until the cache is emptied: the crash of issue 41, after
+    runs that compiled some kernels and loaded others. Started after the
+    load is too late. ``numba.get_num_threads`` starts it."""
+    if not _started[0]:
+        numba.get_num_threads()
+        _started[0] = True
+
+
+_started = [False]
+
+
 def _say(what):
     """One warning (a line on stderr), once per process and entry."""
     if what not in _told:
@@ -197,6 +219,7 @@ class GuardedCache(caching.FunctionCache):
                                         cachedir.digest())
 
     def load_overload(self, sig, target_context):
+        _threads_up()
         try:
             cres = super().load_overload(sig, target_context)
         except Exception as error:                      # noqa: BLE001 (any damage)
