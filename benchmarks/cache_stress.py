@@ -55,7 +55,8 @@ def command(repo, scene, overrides, out):
 def start(repo, cache, threads, name, scene, overrides, out):
     env = dict(os.environ, PYTHONPATH=str(repo), NUMBA_CACHE_DIR=str(cache),
                NUMBA_NUM_THREADS=str(threads))
-    return subprocess.Popen(command(repo, scene, overrides, out), env=env, cwd=str(ROOT),
+    # (cwd: `python -c` puts it first on sys.path, before PYTHONPATH)
+    return subprocess.Popen(command(repo, scene, overrides, out), env=env, cwd=str(repo),
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
 
 

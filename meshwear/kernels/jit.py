@@ -22,7 +22,11 @@ numba's cache but:
 - names a data file by digests of its key (signature, CPU, bytecode, the
   sources' stamp) and of its contents, writes it before the index names it,
   and checks the contents against their digest when it loads them;
-- takes a loaded entry only if it was compiled for the signature asked for.
+- takes a loaded entry only if it was compiled for the signature asked for;
+- starts numba's threading layer before it loads any kernel: a kernel that
+  calls threaded ones, compiled where those were loaded from the cache, is
+  saved without their start-up and, loaded first in a later process, calls
+  the parallel scheduler at address 0 (numba#8578; :func:`_threads_up`).
 
 Anything else it finds (a foreign, truncated or unreadable entry) it drops
 with one warning (a line on stderr) and compiles anew, saving over it. The source stamp
