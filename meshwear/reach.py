@@ -296,13 +296,7 @@ def _drawn_cloud(vertices, faces, spacing, snap, M, c, low, high, reach):
     empty = np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0)
     if not (total > 0.0 and reach > snap):
         return empty
-    rng = np.random.default_rng(0)
-    pick = np.minimum(np.searchsorted(np.cumsum(areas), rng.random(per) * total),
-                      len(faces) - 1)
-    u, v = rng.random((2, per))
-    s = np.sqrt(u)[:, None]
-    tri = vertices[faces[pick]]
-    drawn = (1.0 - s) * tri[:, 0] + s * ((1.0 - v)[:, None] * tri[:, 1] + v[:, None] * tri[:, 2])
+    drawn, pick = remesh.points_on_faces(vertices, faces, areas, per, np.random.default_rng(0))
     normals = geometry.face_normals(vertices, faces[pick])
     points = (np.matmul(drawn, M) + c[:, None, :]).reshape(-1, 3)
     turned = np.matmul(normals, M).reshape(-1, 3)

@@ -219,6 +219,19 @@ def _edge_faces(lengths, whole, resolution):
     return float(pieces + 3.0 * np.count_nonzero(~whole)) / 3.0
 
 
+def points_on_faces(vertices, faces, areas, count, rng):
+    """``count`` points drawn uniformly on the faces by their ``areas`` (a
+    face by area, then uniform on it: the square root of one uniform for the
+    first corner's share): ``(points (count, 3), the face of each)``."""
+    pick = np.minimum(np.searchsorted(np.cumsum(areas), rng.random(count) * float(areas.sum())),
+                      len(faces) - 1)
+    u, v = rng.random((2, count))
+    s = np.sqrt(u)[:, None]
+    tri = vertices[faces[pick]]
+    return ((1.0 - s) * tri[:, 0] + s * ((1.0 - v)[:, None] * tri[:, 1] + v[:, None] * tri[:, 2]),
+            pick)
+
+
 def sampled_area(vertices, faces, within, rng):
     """Area (m²) of the triangles ``faces`` where ``within(points)`` ((k,)
     bool) holds, estimated from :data:`AREA_SAMPLES` points drawn on them
@@ -228,13 +241,7 @@ def sampled_area(vertices, faces, within, rng):
     total = float(areas.sum())
     if not total > 0.0:
         return 0.0
-    pick = np.minimum(np.searchsorted(np.cumsum(areas), rng.random(AREA_SAMPLES) * total),
-                      len(faces) - 1)
-    # uniform on each triangle: the square root of one uniform for the first corner's share
-    u, v = rng.random((2, AREA_SAMPLES))
-    s = np.sqrt(u)[:, None]
-    tri = vertices[faces[pick]]
-    points = (1.0 - s) * tri[:, 0] + s * ((1.0 - v)[:, None] * tri[:, 1] + v[:, None] * tri[:, 2])
+    points, _ = points_on_faces(vertices, faces, areas, AREA_SAMPLES, rng)
     hits = float(np.count_nonzero(within(points)))
     return total * max(hits - 3.0 * np.sqrt(hits), 0.0) / AREA_SAMPLES
 
