@@ -93,10 +93,29 @@ class Grid:
         """The displacement (m) the ``traction`` (Pa) on the cells causes at
         each cell's centre, by the ``normal`` (Boussinesq) or ``shear``
         (Cerruti, along x) kernel."""
-        padded = self.padded
-        k = self.normal if kernel == "normal" else self.shear
-        out = fft.irfftn(k * fft.rfftn(traction, padded), padded)
-        return out[tuple(slice(0, n) for n in self.shape)]
+        spectrum = self.normal if kernel == "normal" else self.shear
+        return self._inverse(self._forward(traction) * spectrum)
+
+    def _forward(self, traction):
+        """rfftn of ``traction`` zero-padded to :attr:`padded`. In 2-D the
+        real transform runs along the rows the cells fill only (the padding's
+        rows are zero: half the real stage's work), then the complex one
+        along the columns."""
+        traction = np.asarray(traction, float)
+        if len(self.shape) == 1:
+            return fft.rfft(traction, self.padded[0])
+        rows = fft.rfft(traction, self.padded[1], axis=1)
+        return fft.fft(rows, self.padded[0], axis=0, overwrite_x=True)
+
+    def _inverse(self, spectrum):
+        """The cells' part of the inverse of :meth:`_forward` (``spectrum``
+        is overwritten): in 2-D the complex transform along the columns,
+        then the real one along the cells' rows only (the padding's rows
+        are thrown away)."""
+        if len(self.shape) == 1:
+            return fft.irfft(spectrum, self.padded[0], overwrite_x=True)[:self.shape[0]]
+        rows = fft.ifft(spectrum, axis=0, overwrite_x=True)[:self.shape[0]]
+        return np.ascontiguousarray(fft.irfft(rows, self.padded[1], axis=1)[:, :self.shape[1]])
 
 
 def make_grid(shape, spacing, youngs, poisson):
@@ -191,51 +210,101 @@ def _solve_approach(grid, h, approach, allowed, kernel, start, tol, max_iteratio
     return Solution(p, approach, np.where(allowed, u + h - approach, np.inf), iteration, residual)
 
 
+def _dot(a, b):
+    """The dot product of two flat arrays by numpy's own loop: BLAS's
+    (``a @ b``) wakes its threads for it, which on a busy machine wait
+    milliseconds for a product of microseconds."""
+    return float(np.einsum("i,i->", a, b))
+
+
 def _iterate(grid, h, allowed, kernel, p, tol, max_iterations, load=None, approach=0.0):
     """Polonsky and Keer's constrained conjugate gradient from the traction
     ``p``: with ``load``, the total kept (the mean gap of the cells in
     contact removed, the traction rescaled at each iteration), else at the
     given ``approach``. Returns the traction, its displacement ``u``, the
     iterations and the residual (the traction's relative change in the last
-    iteration)."""
+    iteration).
+
+    An iteration convolves the conjugate direction ``t`` only: where no cell
+    was clipped or added the new traction is the old one moved along ``t``
+    (and rescaled), so its displacement follows by linearity, ``u - tau K t``;
+    a full convolution of the traction is left to the iterations that change
+    the contact. The work is done in place on flat arrays (BLAS dot
+    products; the cells in contact as a 0/1 array)."""
+    shape = h.shape
     area = grid.cell_area
-    t = np.zeros_like(h)
-    g_old, conjugate = 1.0, False
+    h = np.ascontiguousarray(h, float).ravel()
+    allowed = np.ascontiguousarray(allowed).ravel()
+    p = np.array(p, float).ravel()
+
+    def convolve(x):
+        return grid.convolve(x.reshape(shape), kernel).ravel()
+
+    u = convolve(p)
+    g, gt, t, touching, new, work = (np.empty_like(h) for _ in range(6))
+    t[:] = 0.0
+    bad = np.empty(h.shape, bool)
+    g_old, conjugate, exact = 1.0, False, True
     iteration, residual = 0, np.inf
-    u = grid.convolve(p, kernel)
     for iteration in range(1, max_iterations + 1):
-        g = u + h
-        touching = p > 0.0
-        if not touching.any():
+        np.add(u, h, out=g)
+        np.greater(p, 0.0, out=touching)             # 1.0 in contact, 0.0 off
+        count = float(touching.sum())
+        if count == 0.0:
             break
-        g -= g[touching].mean() if load is not None else approach
-        G = float(g[touching] @ g[touching])
-        t = np.where(touching, g + (G / g_old if conjugate else 0.0) * t, 0.0)
-        g_old = G
-        r = grid.convolve(t, kernel)
-        if load is not None:
-            r -= r[touching].mean()
-        denominator = float(r[touching] @ t[touching])
-        tau = float(g[touching] @ t[touching]) / denominator if denominator != 0.0 else 0.0
-        previous = p
-        step = p - tau * t
-        p = np.where(allowed, np.maximum(step, 0.0), 0.0)
-        overlap = allowed & (p == 0.0) & (g < 0.0)
-        conjugate = not overlap.any()
-        p = np.where(overlap, p - tau * g, p)
-        if load is not None:
-            p *= load / (p.sum() * area)
-            residual = float(np.abs(p - previous).sum() * area / load)
-            u = grid.convolve(p, kernel)
+        g -= _dot(g, touching) / count if load is not None else approach
+        np.multiply(g, touching, out=gt)
+        G = _dot(gt, gt)
+        if conjugate:
+            t *= G / g_old
+            t += gt
+            t *= touching
         else:
-            # the displacement follows the step by linearity where no cell
-            # was clipped or added (the late iterations): one convolution
-            u = u - tau * r if conjugate and np.array_equal(p, step) else grid.convolve(p, kernel)
+            t[:] = gt
+        g_old = G
+        r = convolve(t)
+        denominator = _dot(r, t)
+        if load is not None:
+            # r less its mean over the contact, in the dot product only
+            denominator -= _dot(r, touching) / count * float(t.sum())
+        tau = _dot(g, t) / denominator if denominator != 0.0 else 0.0
+        np.multiply(t, -tau, out=new)
+        new += p
+        clipped = float(new.min()) < 0.0
+        np.maximum(new, 0.0, out=new)
+        # cells off the contact with a negative gap join it
+        np.less(g, 0.0, out=bad)
+        bad &= allowed
+        bad &= new == 0.0
+        conjugate = not bad.any()
+        if not conjugate:
+            new[bad] -= tau * g[bad]
+        scale = 1.0
+        if load is not None:
+            scale = load / (float(new.sum()) * area)
+            new *= scale
+        np.subtract(new, p, out=work)
+        change = float(np.abs(work, out=work).sum())
+        p, new = new, p
+        if conjugate and not clipped:
+            # the displacement by linearity: one convolution an iteration
+            r *= -tau
+            u += r
+            if scale != 1.0:
+                u *= scale
+            exact = False
+        else:
+            u, exact = convolve(p), True
+        if load is not None:
+            residual = change * area / load
+        else:
             total = float(p.sum())
-            residual = float(np.abs(p - previous).sum() / total) if total > 0.0 else 0.0
+            residual = change / total if total > 0.0 else 0.0
         if residual < tol:
             break
-    return p, u, iteration, residual
+    if not exact:
+        u = convolve(p)      # the displacement afresh, free of the updates' rounding
+    return p.reshape(shape), u.reshape(shape), iteration, residual
 
 
 def shear_at_shift(grid, pressure, friction, shift, turn=None, turn_shift=0.0, start=None,
