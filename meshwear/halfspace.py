@@ -248,12 +248,15 @@ def _iterate(grid, h, allowed, kernel, p, tol, max_iterations, load=None, approa
     iterations and the residual (the traction's relative change in the last
     iteration).
 
-    An iteration convolves the conjugate direction ``t`` only: where no cell
-    was clipped or added the new traction is the old one moved along ``t``
-    (and rescaled), so its displacement follows by linearity, ``u - tau K t``;
-    a full convolution of the traction is left to the iterations that change
-    the contact. The work is done in place on flat arrays (BLAS dot
-    products; the cells in contact as a 0/1 array)."""
+    The directions are preconditioned: the gap on the contact times |k|
+    (:meth:`Grid.precondition`, an approximate inverse of the compliance),
+    which keeps the iterations from growing with the grid. An iteration
+    convolves its direction ``t`` only: where no cell was clipped or added
+    the new traction is the old one moved along ``t`` (and rescaled), so its
+    displacement follows by linearity, ``u - tau K t``; a full convolution of
+    the traction is left to the iterations that change the contact. The work
+    is done in place on flat arrays (the cells in contact as a 0/1 array, to
+    take dot products with)."""
     shape = h.shape
     area = grid.cell_area
     h = np.ascontiguousarray(h, float).ravel()
