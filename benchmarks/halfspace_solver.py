@@ -18,12 +18,13 @@ DC-FFT operator on the same n² cells (non-periodic: the same discretisation
 as ours, so the same peak error). Tamaas starts a solve from the traction
 its model holds: its "cold" solves start from zero traction (a uniform
 pressure, as ours), its "re-solve" from its own solution, which is what
-timing repeated ``solve`` calls measures. Prints two tables and, last, one
-JSON line.
+timing repeated ``solve`` calls measures. Prints our table, the sliding
+step's, Tamaas's beside ours (skipped without it) and, last, one JSON line.
 
-    .venv/bin/python benchmarks/halfspace_solver.py [--grids 32 64 128 256]
+    .venv/bin/python benchmarks/halfspace_solver.py [--grids 32 64 128 256] [--workers 1]
 
-Times are the fastest of five calls (of three for Tamaas's).
+Times are the fastest of five calls (of three for Tamaas's), in one
+process: on a shared machine, compare medians of a few runs.
 """
 
 import argparse
@@ -138,7 +139,7 @@ def ours(grids):
     p0 = 3.0 * LOAD / (2.0 * np.pi * a * a)
     print(f"{platform.machine()}, {os.cpu_count()} cores, scipy.fft workers {fft.get_workers()}; "
           + (f"tamaas {tamaas.__version__}" if tamaas is not None
-             else "tamaas not installed (pip install .[bench]): no comparison"))
+             else "tamaas not installed (pip install -e '.[bench]'): no comparison"))
     rows = []
     print(f"{'grid':>8}{'FFT conv (ms)':>15}{'cold (ms)':>11}{'iter':>6}{'warm (ms)':>11}"
           f"{'iter':>6}{'shear (ms)':>12}{'re-solve (ms)':>15}{'cold / conv':>13}{'p0 error':>10}")
@@ -209,7 +210,7 @@ def main():
     parser.add_argument("--grids", type=int, nargs="+", default=[32, 64, 128, 256],
                         help="cells a side of each grid")
     parser.add_argument("--workers", type=int, default=1,
-                        help="threads of our FFTs (scipy.fft.set_workers; Tamaas's build is serial)")
+                        help="threads of our FFTs (scipy.fft.set_workers; Tamaas runs serial)")
     args = parser.parse_args()
     with fft.set_workers(args.workers):
         rows, slide, a, p0 = ours(args.grids)
