@@ -11,7 +11,10 @@ the FFT evaluates without wrap-around error on a grid padded to at least
 and Liu, Wear 243 (2000) 101-111), and the contact
 conditions are solved by the constrained conjugate gradient of Polonsky and
 Keer (Wear 231 (1999) 206-219): pressure ``p >= 0``, gap ``g >= 0``,
-``p g = 0`` and the total load given.
+``p g = 0`` and the total load given; its directions preconditioned by
+the inverse of the half-space's Fourier symbol, ``|k|`` up to a factor
+(Vollebregt, J. Comput. Phys. 257 (2014) 333-351), so that the iterations
+hardly grow with the grid.
 
 Normal and tangential problems are uncoupled (Goodman's approximation:
 exact for bodies of the same material, ``(1 - 2 nu) / G`` equal; otherwise
