@@ -34,7 +34,8 @@ def main(argv=None):
     p = sub.add_parser("run", help="run a scene and write the ParaView series")
     p.add_argument("scene", help="scene file (TOML, format 1)")
     p.add_argument("-o", "--out", default=None, help="output folder (default: out/<scene name>)")
-    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p.add_argument("-q", "--quiet", action="store_true",
+                   help="no progress bar, no line on compiling kernels")
     p.add_argument("--resume", action="store_true",
                    help="continue the stopped run in OUT from its last checkpoint")
     _set_option(p)
@@ -95,6 +96,18 @@ def main(argv=None):
             stream.reconfigure(errors="replace")
 
     def command():
+        if args.command in ("run", "demo", "check") and not getattr(args, "quiet", False):
+            # a first run compiles its kernels: say so (docs/performance.md)
+            from .kernels.notice import CompileNotice
+
+            with CompileNotice() as notice:
+                code = steps()
+            if notice.done():
+                print(notice.done(), file=sys.stderr)
+            return code
+        return steps()
+
+    def steps():
         if args.command == "run":
             if not args.checkpoint_every >= 0:  # NaN too
                 raise InputError(f"--checkpoint-every: must be a number >= 0, got "

@@ -28,8 +28,8 @@ import logging
 
 import numpy as np
 
-from .kernels.loop import DONE, REFRESH
-from .kernels.mechanism import (advance_mechanism, needs_refresh as _needs_refresh, place_body,
+from .kernels.loop import DONE, REFRESH, loop_for
+from .kernels.mechanism import (mechanism_loop, needs_refresh as _needs_refresh, place_body,
                                 place_surface, push_body, push_reaction,
                                 slot_wrench as _slot_wrench)
 from .packing import body_arrays, motion_arrays
@@ -485,7 +485,7 @@ class Mechanism:
                                                                           state.bodies))
             motions = tuple(motion_arrays(model, body, s) for body, s in zip(model.bodies,
                                                                              state.bodies))
-            k, what, b = advance_mechanism(
+            k, what, b = mechanism_loop(loop_for(model, dynamic=True))(
                 k, stop, model.dt, self.calls, self.model._address, self.data._address,
                 self.compiled_arrays(), bodies, motions, self.body_riders, self.placements,
                 self.surface_riders, self.rests, self.rows, self.row_terms, model.cull,

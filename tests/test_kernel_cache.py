@@ -223,3 +223,35 @@ def test_a_cached_kernel_calling_a_threaded_one_runs_from_the_cache(tmp_path, gu
         assert runs[2].returncode == 0 and runs[2].stdout.split() == ["200000.0"]
     else:
         assert runs[2].returncode == -11, "numba's own cache did not crash: the test shows nothing"
+
+
+def test_a_run_that_compiles_says_so_once_and_how_long_it_took():
+    """meshwear.kernels.notice: the first compile prints the line, once
+    however many kernels follow (a kernel compiles those it calls), and
+    ``done`` gives the time; a run that compiles nothing prints nothing."""
+    import io
+
+    import numpy as np
+    from numba import njit
+
+    from meshwear.kernels.notice import STARTING, CompileNotice
+
+    @njit
+    def inner(a):
+        return a.sum()
+
+    @njit
+    def outer(a):
+        return inner(a) + 1.0
+
+    stream = io.StringIO()
+    with CompileNotice(stream) as notice:
+        assert outer(np.ones(3)) == 4.0
+        assert inner(np.ones(2, np.int64)) == 2
+    assert stream.getvalue() == STARTING + "\n"
+    assert notice.count == 2 and notice.seconds > 0.0
+    assert notice.done().startswith("kernels compiled in ")
+    quiet = io.StringIO()
+    with CompileNotice(quiet) as again:
+        outer(np.ones(3))                      # compiled already
+    assert quiet.getvalue() == "" and again.done() == ""

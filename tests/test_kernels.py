@@ -505,3 +505,31 @@ def test_a_point_touching_down_on_a_sliding_surface_slips_in_its_first_step(kern
         0.4 * 1.0 * v * dt)
     assert resting["contact_state"][0, 0] == contact.STICK
     assert resting["wear_depth"][0] == 0.0 and not resting["tangential"][0, 0, contact.FORCE].any()
+
+
+@pytest.mark.parametrize("n_planes", [1, 2])
+def test_the_threaded_kernel_gives_the_serial_results_bit_for_bit(n_planes):
+    """The threaded kernel runs the serial build on pieces of the active set
+    (docs/performance.md, "The first run compiles"): every vertex's results
+    are the serial ones to the last bit, over several pieces and steps, and
+    the wrench is the sum of the same terms (added piece by piece)."""
+    n = 8 * contact.CHUNK + 37                  # eight pieces, of unequal length
+    assert contact.pieces(n) == 8
+    rng = np.random.default_rng(5 + n_planes)
+    vertices, pose, planes, params, law, direction, arrays = _random_case(
+        rng, n, n_planes, contact.ENERGY, False)
+    arrays["active"] = np.flatnonzero(np.arange(n) % 7 != 3)
+    runs = []
+    for kernel in (contact.contact_serial, contact.contact_parallel):
+        v, a = vertices.copy(), {k: x.copy() for k, x in arrays.items()}
+        for _ in range(3):
+            _call(kernel, v, pose, planes, params, law, direction, a)
+        runs.append((v, a))
+    (v0, a0), (v1, a1) = runs
+    assert np.count_nonzero(a0["contact_state"]) > n // 10      # many in contact
+    assert np.array_equal(v0, v1)
+    for name in ("contact_state", "tangential", "normal_force", "friction_work", "wear_depth",
+                 "wear_volume"):
+        assert np.array_equal(a0[name], a1[name]), name
+    assert np.allclose(a1["wrench"], a0["wrench"], rtol=1e-12,
+                       atol=1e-12 * np.abs(a0["wrench"]).max())

@@ -174,16 +174,25 @@ def test_a_load_nothing_carries_stops_the_compiled_loop_as_the_python_step(tmp_p
 
 
 def test_a_first_run_compiles_the_loop_its_scene_needs(tmp_path):
-    """Free bodies on one plane, dynamic (the demo), step in the build that
-    leaves out the paths and the quasi-static balance; a guided body on one
-    plane, or a quasi-static run, in the one-plane build that has them; a
-    mesh counter-surface in the full build (docs/performance.md, "The first
-    run compiles")."""
+    """Each scene steps in the build of the loop that has only what it uses
+    (docs/performance.md, "The first run compiles"): free bodies on one
+    plane, dynamic (the demo), leave out the paths and the quasi-static
+    step; a guided body on one plane keeps its path; a turning mesh disc
+    brings the mesh kernels and no other kind's; none of them the threaded
+    kernels (too few vertices) nor the worn counter's."""
     from meshwear.kernels import loop
 
     scenes = _scenes(tmp_path)
-    builds = {name: loop.loop_for(build_model(scenes[name])) for name in
+    builds = {name: loop.scene_build(build_model(scenes[name])) for name in
               ("free cube, plane", "guided block, dynamic", "pin, turning disc mesh")}
-    assert builds["free cube, plane"] is loop.advance_body_one_plane_free
-    assert builds["guided block, dynamic"] is loop.advance_body_one_plane
-    assert builds["pin, turning disc mesh"] is loop.advance_body
+    assert builds["free cube, plane"] == dict(kinds=(), worn=False, threaded=False,
+                                              case=loop.ONE_PLANE, dynamic=True, free=True)
+    assert builds["guided block, dynamic"] == dict(kinds=(), worn=False, threaded=False,
+                                                   case=loop.ONE_PLANE, dynamic=True, free=False)
+    assert builds["pin, turning disc mesh"] == dict(kinds=("mesh",), worn=False, threaded=False,
+                                                    case=loop.ONE_SURFACE, dynamic=False,
+                                                    free=False)
+    # one build per kind of scene, made once
+    assert loop.loop_for(build_model(scenes["free cube, plane"])) is loop.loop_build(
+        **builds["free cube, plane"])
+    assert loop.loop_build() is loop.advance_body

@@ -32,7 +32,7 @@ from numba import prange
 
 from .jit import njit
 
-from .contact import _named_copy, rotation_entries
+from .contact import _named_copy, pieces, rotation_entries
 from .frames import offset, to_frame
 
 CYLINDER_RADIUS, CYLINDER_HALF_LENGTH, SIDE = 0, 1, 2
@@ -67,7 +67,7 @@ def _none(out, distance, i):
 def _cylinder_planes(body_vertices, pose, active, rotation, frame, geometry, out, distance):
     pose_rotation = rotation_entries(pose[3:7])
     radius, half, sign = geometry[0], geometry[1], 1.0 - 2.0 * geometry[2]
-    for k in prange(active.shape[0]):
+    for k in range(active.shape[0]):
         i = active[k]
         # the vertex in the cylinder's frame: y = Rc^T (x - origin)
         ex, ey, ez = offset(pose_rotation, pose, body_vertices, i, frame)
@@ -92,7 +92,7 @@ def _cylinder_planes(body_vertices, pose, active, rotation, frame, geometry, out
 def _sphere_planes(body_vertices, pose, active, rotation, frame, geometry, out, distance):
     pose_rotation = rotation_entries(pose[3:7])
     radius, sign = geometry[0], 1.0 - 2.0 * geometry[1]
-    for k in prange(active.shape[0]):
+    for k in range(active.shape[0]):
         i = active[k]
         # the vertex's offset from the centre (a sphere needs no frame axes)
         ex, ey, ez = offset(pose_rotation, pose, body_vertices, i, frame)
@@ -108,9 +108,25 @@ def _sphere_planes(body_vertices, pose, active, rotation, frame, geometry, out, 
 
 cylinder_planes_serial = njit(cache=True, fastmath={"contract"})(
     _named_copy(_cylinder_planes, "cylinder_planes_serial"))
-cylinder_planes_parallel = njit(cache=True, parallel=True, fastmath={"contract"})(
-    _named_copy(_cylinder_planes, "cylinder_planes_parallel"))
 sphere_planes_serial = njit(cache=True, fastmath={"contract"})(
     _named_copy(_sphere_planes, "sphere_planes_serial"))
-sphere_planes_parallel = njit(cache=True, parallel=True, fastmath={"contract"})(
-    _named_copy(_sphere_planes, "sphere_planes_parallel"))
+
+#: the serial build a copy of _threaded runs on each piece
+SERIAL_BUILD = None
+
+
+def _threaded(body_vertices, pose, active, rotation, frame, geometry, out, distance):
+    """SERIAL_BUILD on pieces of ``active`` in threads (each piece writes its
+    own vertices only: the serial results, bit for bit; the threaded build
+    compiles only this loop: :func:`meshwear.kernels.contact._threaded`)."""
+    n = active.shape[0]
+    chunks = pieces(n)
+    for c in prange(chunks):
+        SERIAL_BUILD(body_vertices, pose, active[c * n // chunks:(c + 1) * n // chunks],
+                     rotation, frame, geometry, out, distance)
+
+
+cylinder_planes_parallel = njit(cache=True, parallel=True)(
+    _named_copy(_threaded, "cylinder_planes_parallel", SERIAL_BUILD=cylinder_planes_serial))
+sphere_planes_parallel = njit(cache=True, parallel=True)(
+    _named_copy(_threaded, "sphere_planes_parallel", SERIAL_BUILD=sphere_planes_serial))

@@ -5,10 +5,11 @@ counter-surface ``s`` (the analytic planes first, then the mesh surfaces), the
 phases of docs/model.md in order: penetration, normal force (eq. 1), the
 stick/slip state machine (eq. 2-4), dissipated energy, wear (eq. 5 and its
 variants) and the geometry update. Fusing keeps each vertex's data in registers
-for one pass. The kernel is compiled four times from the one definition
-:func:`_contact`: serial and threaded, each in general and for the common case
-of one analytic plane and no mesh surface (see :func:`_build`); what made it
-fast is in docs/performance.md.
+for one pass. The kernel is compiled three times from the one definition
+:func:`_contact`: in general, for the common case of one analytic plane and
+no per-vertex surface, and for one per-vertex surface and no plane; the
+threaded kernel runs the same builds in threads, on pieces of the active set
+(see :func:`_build`). What made it fast is in docs/performance.md.
 
 Array conventions (all C-contiguous float64 unless said otherwise):
 
@@ -174,7 +175,7 @@ def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear
         local[s, 2] = r02 * nx + r12 * ny + r22 * nz
         turns = planes[s, 3, 0] != 0.0 or planes[s, 3, 1] != 0.0 or planes[s, 3, 2] != 0.0
         local[s, 3] = 1.0 if turns else 0.0
-    for slot in prange(active.shape[0]):
+    for slot in range(active.shape[0]):
         # unsigned, so that indexing skips numpy's negative-index wrap-around
         i = np.uint64(active[slot])
         bx, by, bz = body_vertices[i, 0], body_vertices[i, 1], body_vertices[i, 2]
@@ -426,18 +427,66 @@ _FLAGS = {"contract"}
 #: each kernel's builds by name: general, one plane, one surface
 BUILDS = {}
 
+#: the threaded kernel's pieces: a power of two of them (so that they share
+#: out evenly over 2, 4, 8 ... threads), at most :data:`CHUNKS`, of at least
+#: :data:`CHUNK` active vertices each; a split fixed by the active set alone,
+#: so that the wrench's sum is the same whatever the number of threads
+CHUNKS, CHUNK = 64, 512
+
+
+@njit(cache=True, inline="always")
+def pieces(n):
+    """How many pieces the threaded kernels cut ``n`` active vertices into."""
+    chunks = 1
+    while chunks < CHUNKS and 2 * chunks * CHUNK <= n:
+        chunks *= 2
+    return chunks
+#: the serial build a copy of _threaded runs on each piece, set per copy by _build
+SERIAL_BUILD = None
+
+
+def _threaded(body_vertices, pose, planes, vertex_planes, active, area, law, wear_direction,
+              contact_state, tangential, normal_force, friction_work, wear_depth, wear_volume,
+              wrench):
+    """The threaded kernel: SERIAL_BUILD on pieces of ``active`` in threads,
+    their wrenches added in order. Each piece touches only its own vertices,
+    so the per-vertex results are the serial kernel's, bit for bit; and the
+    threaded build compiles only this loop, not the kernel once more (numba
+    compiles a threaded loop's body anew: 10-20 s for the kernel's)."""
+    n = active.shape[0]
+    chunks = pieces(n)
+    partial = np.zeros((chunks, 6))
+    for c in prange(chunks):
+        SERIAL_BUILD(body_vertices, pose, planes, vertex_planes,
+                     active[c * n // chunks:(c + 1) * n // chunks], area, law, wear_direction,
+                     contact_state, tangential, normal_force, friction_work, wear_depth,
+                     wear_volume, partial[c])
+    for j in range(6):
+        total = 0.0
+        for c in range(chunks):
+            total += partial[c, j]
+        wrench[j] = total
+
 
 def _build(name, parallel):
     """``name``: the kernel, serial or threaded, dispatching to its general
     build or to the ones compiled for one analytic plane and no per-vertex
     surface, and for one per-vertex surface and no plane (also in
-    :data:`BUILDS`, for a caller that knows its case and compiles only it)."""
-    options = dict(cache=True, fastmath=_FLAGS, error_model="numpy", parallel=parallel)
-    general = njit(**options)(_named_copy(_contact, name + "_general"))
-    one_plane = njit(**options)(_named_copy(_contact, name + "_one_plane", ONE_PLANE=True))
-    one_surface = njit(**options)(_named_copy(_contact, name + "_one_surface",
-                                              ONE_SURFACE=True))
-    BUILDS[name] = (general, one_plane, one_surface)
+    :data:`BUILDS`, for a caller that knows its case and compiles only it).
+    A threaded build runs the serial build of its case in threads."""
+    if parallel:
+        builds = tuple(njit(cache=True, parallel=True)(_named_copy(
+            _threaded, f"{name}_{case}", SERIAL_BUILD=serial))
+            for case, serial in zip(("general", "one_plane", "one_surface"),
+                                    BUILDS["contact_serial"]))
+    else:
+        options = dict(cache=True, fastmath=_FLAGS, error_model="numpy")
+        builds = (njit(**options)(_named_copy(_contact, name + "_general")),
+                  njit(**options)(_named_copy(_contact, name + "_one_plane", ONE_PLANE=True)),
+                  njit(**options)(_named_copy(_contact, name + "_one_surface",
+                                              ONE_SURFACE=True)))
+    BUILDS[name] = builds
+    general, one_plane, one_surface = builds
     return njit(cache=True)(_named_copy(_dispatch, name, GENERAL_BUILD=general,
                                         ONE_PLANE_BUILD=one_plane,
                                         ONE_SURFACE_BUILD=one_surface))

@@ -30,11 +30,14 @@ from .jit import njit
 
 from .analytic import (cylinder_planes_parallel, cylinder_planes_serial, sphere_planes_parallel,
                        sphere_planes_serial)
+from .contact import _named_copy
 from .frames import surface_frame
 from .nearest import nearest_planes_parallel, nearest_planes_serial
 
 MESH, CYLINDER, SPHERE = 0, 1, 2
 KINDS = {"mesh": MESH, "cylinder": CYLINDER, "sphere": SPHERE}
+#: the kinds' names by code
+NAMES = {code: name for name, code in KINDS.items()}
 SURFACE_FIELDS = ("kind", "geometry", "motion", "terms", "frozen", "counter_vertices", "faces",
                   "frames", "corner_normals", "search", "boxes", "nodes", "order", "neighbours",
                   "part")
@@ -43,8 +46,7 @@ SURFACE_FIELDS = ("kind", "geometry", "motion", "terms", "frozen", "counter_vert
 PARALLEL_THRESHOLD = 2048
 
 
-@njit(cache=True)
-def fill_planes(surface, t, body_vertices, pose, active, out, distance, hint, buffer, rotation,
+def _fill_planes(surface, t, body_vertices, pose, active, out, distance, hint, buffer, rotation,
                 frame):
     """The plane under each ``active`` vertex of a body at ``pose``, at time
     ``t``, into ``out`` (n, 3, 3), ``distance`` (n,) and, for meshes, ``hint``
@@ -54,35 +56,73 @@ def fill_planes(surface, t, body_vertices, pose, active, out, distance, hint, bu
      search, boxes, nodes, order, neighbours, part) = surface
     surface_frame(motion, terms, t, frozen, buffer, rotation, frame)
     threads = active.shape[0] >= PARALLEL_THRESHOLD
-    if kind == MESH:
-        # its faces stay put in its frame: the frame turns only for a
-        # turning surface that is not frozen, and wear moves faces
-        fixed = (frozen or motion[15] == 0.0) and part[0][0] < 0.0
-        # and its frame stays where it was: no path (zero rows add nothing)
-        steady = fixed
-        for m in range(terms.shape[0]):
-            for j in range(1, 9):
-                steady = steady and terms[m, j] == 0.0
-        if threads:
-            nearest_planes_parallel(body_vertices, pose, active, rotation, frame,
-                                    counter_vertices, faces, frames, corner_normals, search,
-                                    boxes, nodes, order, neighbours, out, distance, hint, fixed,
-                                    steady)
-        else:
+    # (each kind and the threaded kernels under a constant of the build, so
+    # that a build compiles only the kernels of its kinds: fill_planes_for)
+    if HAS_MESH:
+        if kind == MESH:
+            # its faces stay put in its frame: the frame turns only for a
+            # turning surface that is not frozen, and wear moves faces
+            fixed = (frozen or motion[15] == 0.0) and part[0][0] < 0.0
+            # and its frame stays where it was: no path (zero rows add nothing)
+            steady = fixed
+            for m in range(terms.shape[0]):
+                for j in range(1, 9):
+                    steady = steady and terms[m, j] == 0.0
+            if THREADED:
+                if threads:
+                    nearest_planes_parallel(body_vertices, pose, active, rotation, frame,
+                                            counter_vertices, faces, frames, corner_normals,
+                                            search, boxes, nodes, order, neighbours, out,
+                                            distance, hint, fixed, steady)
+                    return
             nearest_planes_serial(body_vertices, pose, active, rotation, frame, counter_vertices,
                                   faces, frames, corner_normals, search, boxes, nodes, order,
                                   neighbours, out, distance, hint, fixed, steady)
-    elif kind == CYLINDER:
-        if threads:
-            cylinder_planes_parallel(body_vertices, pose, active, rotation, frame, geometry, out,
-                                     distance)
-        else:
+            return
+    if HAS_CYLINDER:
+        if kind == CYLINDER:
+            if THREADED:
+                if threads:
+                    cylinder_planes_parallel(body_vertices, pose, active, rotation, frame,
+                                             geometry, out, distance)
+                    return
             cylinder_planes_serial(body_vertices, pose, active, rotation, frame, geometry, out,
                                    distance)
-    elif kind == SPHERE:
-        if threads:
-            sphere_planes_parallel(body_vertices, pose, active, rotation, frame, geometry, out,
-                                   distance)
-        else:
+            return
+    if HAS_SPHERE:
+        if kind == SPHERE:
+            if THREADED:
+                if threads:
+                    sphere_planes_parallel(body_vertices, pose, active, rotation, frame,
+                                           geometry, out, distance)
+                    return
             sphere_planes_serial(body_vertices, pose, active, rotation, frame, geometry, out,
                                  distance)
+            return
+
+
+#: the build's constants: the kinds it handles, and the threaded kernels
+HAS_MESH = HAS_CYLINDER = HAS_SPHERE = THREADED = True
+
+#: the builds made so far, by :func:`fill_planes_for`'s arguments
+_FILLS = {}
+
+
+def fill_planes_for(kinds, threaded):
+    """:func:`fill_planes` compiled for the surface kinds ``kinds`` (names
+    of :data:`KINDS`) only, with the threaded kernels if ``threaded``; a
+    surface of another kind is left unfilled."""
+    kinds = tuple(sorted(set(kinds)))
+    key = (kinds, bool(threaded))
+    if key not in _FILLS:
+        constants = {"HAS_" + k.upper(): k in kinds for k in KINDS}
+        name = "fill_planes" + ("" if key == (tuple(sorted(KINDS)), True) else
+                                "_" + "".join(k[0] for k in kinds) + ("_threads" if threaded
+                                                                       else "_serial"))
+        _FILLS[key] = njit(cache=True)(_named_copy(_fill_planes, name, THREADED=bool(threaded),
+                                                   **constants))
+    return _FILLS[key]
+
+
+#: every kind, threaded or not
+fill_planes = fill_planes_for(KINDS, True)

@@ -79,7 +79,7 @@ from numba import prange
 
 from .jit import njit
 
-from .contact import NO_CONTACT, SLIP, _named_copy, rotation_entries
+from .contact import NO_CONTACT, SLIP, _named_copy, pieces, rotation_entries
 from .laws import wear_increment
 from .nearest import closest_on_triangle
 
@@ -173,7 +173,7 @@ def _pairs(body_vertices, pose, active, area, law, contact_state, normal_force, 
     cx, cy, cz = pose[0], pose[1], pose[2]
     vx, vy, vz = pose[7], pose[8], pose[9]
     wx, wy, wz = pose[10], pose[11], pose[12]
-    for slot in prange(active.shape[0]):
+    for slot in range(active.shape[0]):
         at[slot] = -1
         i = active[slot]
         state = contact_state[i]
@@ -242,7 +242,23 @@ def _pairs(body_vertices, pose, active, area, law, contact_state, normal_force, 
 
 
 _pairs_serial = njit(cache=True)(_named_copy(_pairs, "_pairs_serial"))
-_pairs_parallel = njit(cache=True, parallel=True)(_named_copy(_pairs, "_pairs_parallel"))
+
+
+def _pairs_threaded(body_vertices, pose, active, area, law, contact_state, normal_force, planes,
+                    hint, rotation, frame, counter_law, faces, vertices, at, pairs):
+    """:func:`_pairs` on pieces of ``active`` in threads (as the contact
+    kernel's: :func:`meshwear.kernels.contact._threaded`)."""
+    n = active.shape[0]
+    chunks = pieces(n)
+    for c in prange(chunks):
+        lo, hi = c * n // chunks, (c + 1) * n // chunks
+        _pairs_serial(body_vertices, pose, active[lo:hi], area, law, contact_state, normal_force,
+                      planes, hint, rotation, frame, counter_law, faces, vertices, at[lo:hi],
+                      pairs[lo:hi])
+
+
+_pairs_parallel = njit(cache=True, parallel=True)(_named_copy(_pairs_threaded,
+                                                              "_pairs_parallel"))
 
 
 @njit(cache=True)

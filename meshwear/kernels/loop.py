@@ -44,7 +44,7 @@ from .jit import njit
 from .balance import balance_offset
 from .contact import (BUILDS, PARALLEL_THRESHOLD, _named_copy, contact_parallel, contact_serial,
                       plane_under, rotation_entries)
-from .counter import fill_planes
+from .counter import NAMES, fill_planes, fill_planes_for
 from .counter_wear import wear_counter
 from .frames import moved_since_refresh, plane_rows, step_motion, surface_frame
 from .rigid import (AXIS, BALANCED, CARRIED, FIXED, FREE, advance_free_motion,
@@ -54,19 +54,23 @@ from .rigid import (AXIS, BALANCED, CARRIED, FIXED, FREE, advance_free_motion,
 DONE, REFRESH, FINISH, NO_BALANCE, TOO_DEEP, IMPACT = 0, 1, 2, 3, 4, 5
 
 
-# The loop is compiled in two builds from the one definition (as the contact
-# kernel is, meshwear.kernels.contact._build): the full one, and one for a
-# scene of analytic planes whose bodies are too small for the threaded
-# kernel, which compiles none of the mesh counter-surfaces' kernels nor the
-# threaded contact (numba prunes the branches of a constant False before
-# typing them): a first run of such a scene compiles a fifth of the code.
-#: the build's constants: mesh counter-surfaces, the threaded contact kernel,
-#: and the serial contact kernel it calls
-MESHES, PARALLEL, SERIAL_CONTACT = True, True, contact_serial
+# The loop is compiled in builds from the one definition (as the contact
+# kernel is, meshwear.kernels.contact._build), one per kind of scene
+# (:func:`loop_build`): numba compiles globals as constants and prunes the
+# branches of a constant False before typing them, so a build compiles only
+# the counter-surface kinds, contact case, threads and motions its scenes
+# use, and a first run compiles only the build its scene needs
+# (docs/performance.md, "The first run compiles").
+#: the build's constants: per-vertex counter-surfaces, worn ones, the
+#: threaded contact kernel, and the contact kernels it calls
+MESHES, WORN, PARALLEL = True, True, True
+SERIAL_CONTACT, PARALLEL_CONTACT = contact_serial, contact_parallel
 #: a build for dynamic runs only: the quasi-static step (the path placed at
 #: the step's end, the load balance) is left out (the build for free bodies
 #: also takes ``advance_motion=advance_free_motion``)
 DYNAMIC_ONLY = False
+#: a build for quasi-static runs only: the dynamic step is left out
+QUASI_STATIC_ONLY = False
 
 
 def _fill(body, planes, surfaces, t, buffer, rotation, frame):
@@ -92,11 +96,14 @@ def _touch(body, plane_array):
      friction_work, wear_depth, wear_volume, wrench, vertex_planes, hint, active, active_wear,
      cull, distance, load, radius, depth_limit, impact_room, _, _, _) = body
     slots = plane_array.shape[0] + vertex_planes.shape[0]
-    if PARALLEL and active.shape[0] * slots >= PARALLEL_THRESHOLD:
-        contact_parallel(vertices, pose, plane_array, vertex_planes, active, area, law,
-                         wear_direction, contact_state, tangential, normal_force, friction_work,
-                         wear_depth, wear_volume, wrench)
-    else:
+    threads = False
+    if PARALLEL:
+        threads = active.shape[0] * slots >= PARALLEL_THRESHOLD
+        if threads:
+            PARALLEL_CONTACT(vertices, pose, plane_array, vertex_planes, active, area, law,
+                             wear_direction, contact_state, tangential, normal_force,
+                             friction_work, wear_depth, wear_volume, wrench)
+    if not threads:
         SERIAL_CONTACT(vertices, pose, plane_array, vertex_planes, active, area, law,
                        wear_direction, contact_state, tangential, normal_force, friction_work,
                        wear_depth, wear_volume, wrench)
@@ -229,7 +236,7 @@ def _advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes,
     plane_array = planes[0]
     n_planes = plane_array.shape[0]
     worn = False
-    if MESHES:
+    if WORN:
         for m in range(len(surfaces)):
             worn = worn or surfaces[m][14][0][0] >= 0.0
     rotation, frame = np.zeros((3, 3)), np.zeros((4, 3))
@@ -239,26 +246,28 @@ def _advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes,
             and scratch.shape[1] < active.shape[0] * (plane_array.shape[0] + vertex_planes.shape[0])):
         return k, REFRESH                # Python grows the scratch
     while k < stop:
-        if DYNAMIC_ONLY or not quasi_static:
-            t = k * dt
-            if _needs_refresh(body, bounds, terms, t, dt, buffer, cull_enabled):
-                return k, REFRESH
-            _fill(body, planes, surfaces, t, buffer, rotation, frame)
-            _touch(body, plane_array)
-            if MESHES and worn and not _wear_parts(body, surfaces, law, n_planes, t, buffer,
-                                                   rotation, frame, report):
-                return k, TOO_DEEP
-            if depth_limit > 0.0:
-                slot, vertex = impact_check(vertices, pose, plane_array, vertex_planes, active,
-                                            body[5], depth_limit, impact_room)
-                if slot >= 0:
-                    report[0], report[1] = slot, vertex
-                    return k, IMPACT
-            advance_motion(kind, params, path_terms, buffer, pose, body[11], t, dt)
-            if depth_limit > 0.0:
-                use_impact_room(impact_room, pose, radius, bounds, terms, t, dt, buffer)
-            k += 1
-            continue
+        if not QUASI_STATIC_ONLY:
+            if DYNAMIC_ONLY or not quasi_static:
+                t = k * dt
+                if _needs_refresh(body, bounds, terms, t, dt, buffer, cull_enabled):
+                    return k, REFRESH
+                _fill(body, planes, surfaces, t, buffer, rotation, frame)
+                _touch(body, plane_array)
+                if WORN:
+                    if worn and not _wear_parts(body, surfaces, law, n_planes, t, buffer, rotation,
+                                                frame, report):
+                        return k, TOO_DEEP
+                if depth_limit > 0.0:
+                    slot, vertex = impact_check(vertices, pose, plane_array, vertex_planes, active,
+                                                body[5], depth_limit, impact_room)
+                    if slot >= 0:
+                        report[0], report[1] = slot, vertex
+                        return k, IMPACT
+                advance_motion(kind, params, path_terms, buffer, pose, body[11], t, dt)
+                if depth_limit > 0.0:
+                    use_impact_room(impact_room, pose, radius, bounds, terms, t, dt, buffer)
+                k += 1
+                continue
         # quasi-static: where the path puts the body at the end of the step,
         # with the velocity of that increment (on a copy: a refresh must find
         # the step untouched)
@@ -290,38 +299,80 @@ def _advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes,
                                                     body[9], active, body[15], buffer) >= cull[0]:
                 return k, FINISH
         _touch(body, plane_array)
-        if MESHES and worn and not _wear_parts(body, surfaces, law, n_planes, t, buffer,
-                                               rotation, frame, report):
-            return k, TOO_DEEP
+        if WORN:
+            if worn and not _wear_parts(body, surfaces, law, n_planes, t, buffer, rotation, frame,
+                                        report):
+                return k, TOO_DEEP
         k += 1
     return k, DONE
 
 
-def _loop_build(name, **constants):
-    """The loop compiled with ``constants`` (see :data:`MESHES`) under ``name``."""
+#: the counter-surface kinds a build can meet (:data:`meshwear.kernels.counter.KINDS`)
+ALL_KINDS = ("cylinder", "mesh", "sphere")
+#: the contact kernels' cases (the index into :data:`meshwear.kernels.contact.BUILDS`;
+#: None: the dispatch that picks one at each call)
+GENERAL, ONE_PLANE, ONE_SURFACE = 0, 1, 2
+
+#: the builds made so far, by :func:`loop_build`'s arguments
+_LOOPS = {}
+
+
+def loop_build(kinds=ALL_KINDS, worn=True, threaded=True, case=None, dynamic=None, free=False):
+    """The build of :func:`advance_body` for the scenes that meet per-vertex
+    counter-surfaces of ``kinds`` only (worn ones if ``worn``), have bodies
+    large enough for the threaded kernels (``threaded``), call the contact
+    kernel's ``case`` build, run dynamically (``dynamic`` True), quasi-statically
+    (False) or either (None), and move only free or fixed bodies (``free``).
+    Each build is made once and cached on disk under its own name; the
+    defaults make the full one, :data:`advance_body`."""
+    kinds = tuple(sorted(set(kinds)))
+    worn = worn and bool(kinds)
+    key = (kinds, worn, threaded, case, dynamic, free)
+    if key in _LOOPS:
+        return _LOOPS[key]
+    full = key == (ALL_KINDS, True, True, None, None, False)
+    parts = ["".join(k[0] for k in kinds) or "planes", "worn" if worn else "",
+             "threads" if threaded else "serial",
+             {None: "any", GENERAL: "general", ONE_PLANE: "plane", ONE_SURFACE: "surface"}[case],
+             {None: "", True: "dynamic", False: "quasi"}[dynamic], "free" if free else ""]
+    name = "" if full else "_" + "_".join(p for p in parts if p)
+    constants = dict(MESHES=bool(kinds), WORN=worn, PARALLEL=threaded,
+                     DYNAMIC_ONLY=dynamic is True, QUASI_STATIC_ONLY=dynamic is False,
+                     fill_planes=fill_planes_for(kinds, threaded))
+    if case is not None:
+        constants.update(SERIAL_CONTACT=BUILDS["contact_serial"][case],
+                         PARALLEL_CONTACT=BUILDS["contact_parallel"][case])
+    if free:
+        constants["advance_motion"] = advance_free_motion
     fill = njit(cache=True)(_named_copy(_fill, "_fill" + name, **constants))
     touch = njit(cache=True)(_named_copy(_touch, "_touch" + name, **constants))
-    return njit(cache=True)(_named_copy(_advance_body, "advance_body" + name, _fill=fill,
-                                        _touch=touch, **constants))
+    _LOOPS[key] = njit(cache=True)(_named_copy(_advance_body, "advance_body" + name, _fill=fill,
+                                               _touch=touch, **constants))
+    return _LOOPS[key]
 
 
-#: the loop: every counter-surface, both contact kernels
-advance_body = _loop_build("")
-#: the loop of analytic planes, one plane and bodies of fewer vertices than
-#: the threaded kernel's threshold: the serial one-plane contact only
-advance_body_one_plane = _loop_build("_one_plane", MESHES=False, PARALLEL=False,
-                                     SERIAL_CONTACT=BUILDS["contact_serial"][1])
-#: and of those, a dynamic run of free bodies (tossed or dropped on a floor)
-advance_body_one_plane_free = _loop_build(
-    "_one_plane_free", MESHES=False, PARALLEL=False, SERIAL_CONTACT=BUILDS["contact_serial"][1],
-    DYNAMIC_ONLY=True, advance_motion=advance_free_motion)
+#: the loop: every counter-surface, both contact kernels, either mode
+advance_body = loop_build()
 
 
-def loop_for(model):
-    """The build of :func:`advance_body` that ``model`` needs."""
-    if (model.planes.shape[0] == 1 and not model.surfaces.per_vertex
-            and all(len(b.tributary_area) < PARALLEL_THRESHOLD for b in model.bodies)):
-        if not model.quasi_static and all(b.motion.kind in (FREE, FIXED) for b in model.bodies):
-            return advance_body_one_plane_free
-        return advance_body_one_plane
-    return advance_body
+def scene_build(model, dynamic=None):
+    """:func:`loop_build`'s arguments for ``model``'s scene (``dynamic``: the
+    mode its caller runs the loop in; the model's own by default)."""
+    per_vertex = model.surfaces.per_vertex
+    n_planes, n_surfaces = model.planes.shape[0], len(per_vertex)
+    slots = n_planes + n_surfaces
+    if dynamic is None:
+        dynamic = not model.quasi_static
+    case = (ONE_PLANE if (n_planes, n_surfaces) == (1, 0)
+            else ONE_SURFACE if (n_planes, n_surfaces) == (0, 1) else GENERAL)
+    return dict(kinds=tuple(NAMES[s.kind] for s in per_vertex),
+                worn=any(s.worn for s in per_vertex),
+                threaded=any(len(b.tributary_area) * slots >= PARALLEL_THRESHOLD
+                             for b in model.bodies),
+                case=case, dynamic=dynamic,
+                free=dynamic and all(b.motion.kind in (FREE, FIXED) for b in model.bodies))
+
+
+def loop_for(model, dynamic=None):
+    """The build of :func:`advance_body` that ``model`` needs (see :func:`scene_build`)."""
+    return loop_build(**scene_build(model, dynamic))

@@ -9,7 +9,7 @@ origin). Twins in tests/test_mechanism.py."""
 import numpy as np
 from .jit import njit
 
-from .contact import FORCE, rotation_entries
+from .contact import FORCE, _named_copy, rotation_entries
 from .frames import moved_since_refresh, step_motion
 from .loop import DONE, REFRESH, advance_body
 from .rigid import STEADY, quaternion_product
@@ -219,8 +219,7 @@ def push_reaction(xipos, xfrc, body, wrench):
     xfrc[body, 5] -= wrench[5] - (cx * fy - cy * fx)
 
 
-@njit(cache=True)
-def advance_mechanism(k, stop, dt, calls, m, d, mj, bodies, motions, body_riders, placements,
+def _advance_mechanism(k, stop, dt, calls, m, d, mj, bodies, motions, body_riders, placements,
                       surface_riders, rests, rows, row_terms, cull, world, refs, levers, planes,
                       surfaces, bounds, terms, report):
     """Steps ``k`` up to ``stop`` of a mechanism and every body, without
@@ -300,3 +299,22 @@ def advance_mechanism(k, stop, dt, calls, m, d, mj, bodies, motions, body_riders
                 for j in range(9):
                     planes[2][slot, 0, j] = row_terms[r, 0, j]
     return k, DONE, -1
+
+
+#: the builds made so far, by the step loop's build they call
+_MECHANISM_LOOPS = {}
+
+
+def mechanism_loop(loop=advance_body):
+    """:func:`advance_mechanism` calling the step loop's build ``loop``
+    (:func:`meshwear.kernels.loop.loop_for`), made once and cached on disk
+    under a name of its own."""
+    name = loop.py_func.__qualname__.replace("advance_body", "advance_mechanism", 1)
+    if name not in _MECHANISM_LOOPS:
+        _MECHANISM_LOOPS[name] = njit(cache=True)(_named_copy(_advance_mechanism, name,
+                                                              advance_body=loop))
+    return _MECHANISM_LOOPS[name]
+
+
+#: the one that calls the full loop
+advance_mechanism = mechanism_loop()

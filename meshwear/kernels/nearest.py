@@ -39,7 +39,7 @@ from numba import prange
 
 from .jit import njit
 
-from .contact import _named_copy, rotation_entries  # noqa: F401  (re-exported for twins)
+from .contact import _named_copy, pieces, rotation_entries  # noqa: F401  (re-exported for twins)
 from .frames import to_frame
 from .tree import STACK, box_distance2
 
@@ -270,7 +270,7 @@ def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_verti
     q00, q01, q02 = rotation[0, 0], rotation[0, 1], rotation[0, 2]
     q10, q11, q12 = rotation[1, 0], rotation[1, 1], rotation[1, 2]
     q20, q21, q22 = rotation[2, 0], rotation[2, 1], rotation[2, 2]
-    for k in prange(active.shape[0]):
+    for k in range(active.shape[0]):
         # unsigned, so that indexing skips numpy's negative-index wrap-around
         i = np.uint64(active[k])
         # world position, then counter frame: y = Rc^T (x - origin)
@@ -472,9 +472,26 @@ def face_frames(vertices, faces):
 # fastmath "contract" only, as the contact kernel (FMA; IEEE NaN and infinity kept)
 nearest_planes_serial = njit(cache=True, fastmath={"contract"}, error_model="numpy")(
     _named_copy(_nearest_planes, "nearest_planes_serial"))
-nearest_planes_parallel = njit(cache=True, parallel=True, fastmath={"contract"},
-                               error_model="numpy")(
-    _named_copy(_nearest_planes, "nearest_planes_parallel"))
+
+
+def _nearest_threaded(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
+                      frames, corner_normals, search, boxes, nodes, order, neighbours, out,
+                      distance, hint, fixed, steady):
+    """The serial query on pieces of ``active`` in threads (each piece
+    writes its own vertices only: the serial results, bit for bit), so that
+    the threaded build compiles this loop only (as the contact kernel's:
+    :func:`meshwear.kernels.contact._threaded`)."""
+    n = active.shape[0]
+    chunks = pieces(n)
+    for c in prange(chunks):
+        nearest_planes_serial(body_vertices, pose, active[c * n // chunks:(c + 1) * n // chunks],
+                              rotation, motion, counter_vertices, faces, frames, corner_normals,
+                              search, boxes, nodes, order, neighbours, out, distance, hint, fixed,
+                              steady)
+
+
+nearest_planes_parallel = njit(cache=True, parallel=True)(
+    _named_copy(_nearest_threaded, "nearest_planes_parallel"))
 
 #: active vertices from which the threaded query pays for its threads
 PARALLEL_THRESHOLD = 2048

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import fcl
 import numpy as np
+import numba
 from numba.typed import List
 
 from ..kernels.jit import njit
@@ -105,8 +106,10 @@ class SurfaceSet:
         return self._compiled_planes
 
     def compiled_list(self):
-        """The per-vertex surfaces' tuples as the numba typed list the
-        compiled loop takes (rebuilt when one changed: a face tree built)."""
+        """The per-vertex surfaces' tuples as the compiled loop takes them
+        (rebuilt when one changed: a face tree built): a tuple of them (it
+        needs no compile, a typed list of them does: 5 s on a first run), or
+        a numba typed list where their types differ."""
         tuples = [s.compiled() for s in self.per_vertex]
         # the tuples themselves are kept (not their ids: a freed tuple's id
         # can come back for the next one, a worn surface attached anew)
@@ -115,12 +118,16 @@ class SurfaceSet:
                 a is not b for a, b in zip(held, tuples)):
             # built by cached compiled functions: a typed list built from
             # Python compiles its methods anew in every process (1 s here)
-            if tuples:
+            if len({numba.typeof(t) for t in tuples}) == 1:
+                self._list = tuple(tuples)
+            elif tuples:
                 self._list = _list_of(tuples[0])
                 for t in tuples[1:]:
                     _append(self._list, t)
             else:
-                self._list = _empty_list_of(_sample_tuple())
+                # the loop's builds for planes only never read it
+                # (meshwear.kernels.loop.loop_build): no typed list to compile
+                self._list = ()
             self._list_tuples = tuples
         return self._list
 
@@ -197,22 +204,6 @@ def _list_of(item):
 @njit(cache=True)
 def _append(items, item):
     items.append(item)
-
-
-@njit(cache=True)
-def _empty_list_of(sample):
-    """An empty typed list of ``sample``'s type."""
-    out = List()
-    out.append(sample)
-    out.pop()
-    return out
-
-
-def _sample_tuple():
-    """A surface tuple, for the item type of an empty typed list."""
-    from .analytic import Sphere
-
-    return Sphere("sample", 1.0, (0.0, 0.0, 0.0)).compiled()
 
 
 @dataclass

@@ -227,8 +227,10 @@ class CounterSurface:
     def fill(self, body_vertices, pose, active, out, distance, hint, t):
         """Per-vertex kinds: the plane under each ``active`` vertex at ``t``
         (:func:`meshwear.kernels.counter.fill_planes`)."""
-        from ..kernels.counter import fill_planes
+        from ..kernels.counter import NAMES, PARALLEL_THRESHOLD, fill_planes_for
 
+        # (the build of this kind only: a first run compiles no other kind's kernels)
+        fill_planes = fill_planes_for((NAMES[self.kind],), len(active) >= PARALLEL_THRESHOLD)
         fill_planes(self.compiled(), float(t), body_vertices, pose, active, out, distance, hint,
                     self.motion.buffer, np.zeros((3, 3)), np.zeros((4, 3)))
 
