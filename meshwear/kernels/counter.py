@@ -6,7 +6,9 @@ A counter-surface that is not a uniform analytic plane hands the step loop a
 puts it where it is at ``t`` and calls the kernel its ``kind`` names: the
 table of kinds below. Adding a surface type is one kernel with the signature
 of :func:`meshwear.kernels.analytic.cylinder_planes_serial`, one code here
-and one class in :mod:`meshwear.surfaces`.
+(and its branch in :func:`_fill_planes` under a ``HAS_`` constant of its
+own, so that the builds of :func:`fill_planes_for` compile only the kinds a
+scene meets) and one class in :mod:`meshwear.surfaces`.
 
 A surface tuple holds, in order (unused arrays empty):
 
