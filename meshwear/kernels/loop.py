@@ -44,7 +44,7 @@ from .jit import njit
 from .balance import balance_offset
 from .contact import (BUILDS, PARALLEL_THRESHOLD, _named_copy, contact_parallel, contact_serial,
                       plane_under, rotation_entries)
-from .counter import NAMES, fill_planes, fill_planes_for
+from .counter import NAMES, PARALLEL_THRESHOLD as LOOKUP_THRESHOLD, fill_planes, fill_planes_for
 from .counter_wear import wear_counter
 from .frames import moved_since_refresh, plane_rows, step_motion, surface_frame
 from .rigid import (AXIS, BALANCED, CARRIED, FIXED, FREE, advance_free_motion,
@@ -367,7 +367,10 @@ def scene_build(model, dynamic=None):
             else ONE_SURFACE if (n_planes, n_surfaces) == (0, 1) else GENERAL)
     return dict(kinds=tuple(NAMES[s.kind] for s in per_vertex),
                 worn=any(s.worn for s in per_vertex),
+                # (the threaded contact from its threshold of vertex-surface
+                # pairs, the threaded lookups from theirs of vertices)
                 threaded=any(len(b.tributary_area) * slots >= PARALLEL_THRESHOLD
+                             or (n_surfaces and len(b.tributary_area) >= LOOKUP_THRESHOLD)
                              for b in model.bodies),
                 case=case, dynamic=dynamic,
                 free=dynamic and all(b.motion.kind in (FREE, FIXED) for b in model.bodies))
