@@ -339,6 +339,7 @@ def _check(scene_path, overrides=()):
               f"mass {mass}, motion {config.motion}")
         if b.refinement:
             print(f"    {describe_refinement(b.refinement)}")
+        print(f"    active-set margin {b.margin:.3g} m: {b.margin_reason}")
     for surface, config in zip(model.surfaces.slots, _slot_configs(scene, model)):
         print(f"  {_surface_summary(surface, config)}, {surface.describe()}")
         if getattr(surface, "refinement", None):
@@ -346,6 +347,8 @@ def _check(scene_path, overrides=()):
     stable = (f"largest stable dt {limit:.3g} s" if np.isfinite(limit)
               else "no stability limit (quasi-static)" if model.quasi_static
               else "no stability limit (nothing integrated in time)")
+    if model.dt_reason != "run.dt":
+        stable += f"; {model.dt_reason}"
     print(f"  dt {model.dt:.3g} s, {stable}, {model.n_steps} steps, "
           f"{len(model.frame_steps)} frames, {len(model.sample_steps)} history rows")
     from .model import initial_state

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import geometry, reach, remesh, surfaces
+from .surfaces.margin import contact_margin
 from .dynamics import OwnMotions
 from .elastic import HalfSpace, PatchError
 from .elastic import step as elastic_step
@@ -71,6 +72,10 @@ class BodyModel:
         its thinnest extent; 0 for bodies placed by their path.
     refinement : dict or None
         What ``resolution`` did (:func:`meshwear.remesh.refine_part`).
+    margin : float
+        Its default active-set margin (m), used where ``contact.margin`` is
+        not given, and why (``margin_reason``):
+        :func:`meshwear.surfaces.margin.contact_margin`.
     """
 
     name: str
@@ -89,6 +94,8 @@ class BodyModel:
     radius: float = 0.0
     depth_limit: float = 0.0
     refinement: dict | None = None
+    margin: float = 0.0
+    margin_reason: str = ""
 
 
 @dataclass(frozen=True, eq=False)
@@ -125,6 +132,8 @@ class Model:
     #: the half-space contact's constants (:class:`meshwear.elastic.HalfSpace`),
     #: or None: the Winkler foundation of ``law``
     elastic: object = None
+    #: what set ``dt``: "run.dt", or the limit of ``"auto"`` that did (:func:`auto_time_step_why`)
+    dt_reason: str = "run.dt"
 
     @property
     def dynamics(self):
@@ -444,7 +453,9 @@ def build_model(scene):
                  surfaces=surface_set,
                  quasi_static=quasi_static, dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
                  frame_steps=_even_steps(n_steps, run.frames), period=period,
-                 cycle_steps=cycle_steps, mechanism=mechanism, elastic=elastic)
+                 cycle_steps=cycle_steps, mechanism=mechanism, elastic=elastic,
+                 dt_reason=("run.dt" if run.dt != "auto"
+                            else "auto: " + auto_time_step_why(scene, period, limit)[1]))
 
 
 def _part_key(prefix, config):
@@ -536,10 +547,18 @@ def auto_time_step(scene, period, limit):
     :data:`AUTO_STEPS_PER_CYCLE`-th of the motion's cycle ``period`` (None
     when nothing moves periodically) or a :data:`AUTO_STEPS_PER_RUN`-th of
     the duration."""
-    step = scene.run.duration / AUTO_STEPS_PER_RUN
+    return auto_time_step_why(scene, period, limit)[0]
+
+
+def auto_time_step_why(scene, period, limit):
+    """:func:`auto_time_step` and which of its limits set it, in words."""
+    choices = [(scene.run.duration / AUTO_STEPS_PER_RUN,
+                f"1/{AUTO_STEPS_PER_RUN} of the duration")]
     if period is not None:
-        step = min(step, period / AUTO_STEPS_PER_CYCLE)
-    return min(step, limit)
+        choices.append((period / AUTO_STEPS_PER_CYCLE,
+                        f"1/{AUTO_STEPS_PER_CYCLE} of the {period:.4g} s cycle"))
+    choices.append((limit, "the largest stable step"))
+    return min(choices, key=lambda c: c[0])
 
 
 #: most steps a run may take (counts stay exact in float64 times)
@@ -661,16 +680,18 @@ def _build_body(scene, index, body, surface_set, mechanism=None, loaded=None):
     motion.place(pose, 0.0)
     if not np.all(np.isfinite(pose)):
         raise SceneError(scene.source, key, "initial pose is not finite")
+    vectors = geometry.area_vectors(body_vertices, faces)
+    margin, why = (scene.contact.margin, "contact.margin") if scene.contact.margin else \
+        contact_margin(scene, body, body_vertices, vectors, pose, motion, surface_set)
     return BodyModel(
         name=body.name, faces=faces, reference_vertices=body_vertices, tributary_area=area,
-        area_vectors=geometry.area_vectors(body_vertices, faces),
-        wear_direction=wear_direction,
+        area_vectors=vectors, wear_direction=wear_direction,
         reference_face_normals=geometry.face_normals(body_vertices, faces),
         mass=float(mass), inertia=inertia, origin=-com, initial_pose=pose, motion=motion,
         period=path.period, radius=float(np.linalg.norm(body_vertices, axis=1).max()),
         depth_limit=(IMPACT_DEPTH * _thinnest(body_vertices)
                      if motion.dynamic_axes is not None and not riding else 0.0),
-        refinement=refinement)
+        refinement=refinement, margin=float(margin), margin_reason=why)
 
 
 #: a worn counter-part spreads a contact's wear as far as this many times

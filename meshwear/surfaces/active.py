@@ -225,6 +225,8 @@ def margin_of(scene, body):
     given = scene.contact.margin
     if given is not None:
         return float(given)
+    if body.margin > 0.0:       # sized by its contact where it can be (surfaces/margin.py)
+        return body.margin
     return MARGIN_FRACTION * float(np.linalg.norm(np.ptp(body.reference_vertices, axis=0)))
 
 
