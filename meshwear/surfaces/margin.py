@@ -33,6 +33,7 @@ default: their contact is not known before the run.
 import numpy as np
 
 from ..kernels.laws import LAWS
+from ..kernels.rigid import BALANCED
 from .active import MARGIN_FRACTION
 from .base import quaternion_matrix
 
@@ -70,7 +71,7 @@ def contact_margin(scene, config, vertices, area_vectors, pose, motion, surface_
     fallback = (size, f"{MARGIN_FRACTION:g} of the body's size")
     c = scene.contact
     # a quasi-static guided body (meshwear.motion.BalancedMotion) carries a load
-    load = abs(float(getattr(motion, "carried", 0.0)))
+    load = abs(float(motion.carried)) if motion.kind == BALANCED else 0.0
     # a turning mesh's shape invariance is judged against the margin
     # (MeshSurface.settle_invariance): a ring faceted by more than a quarter
     # of a contact-sized margin would be followed as it turns, at a cost
