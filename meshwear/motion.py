@@ -253,6 +253,34 @@ class TurningMotion(Motion):
 
     ensure_scratch = BalancedMotion.ensure_scratch
 
+    @property
+    def turn_axis(self):
+        return self.params[TURN_AXIS]
+
+    def center_of(self, pose):
+        """(3,) the point the turn's axis passes through with the body at
+        ``pose`` (m): the centre of mass less its offset from the axis's
+        place at t = 0, turned as the body has turned since."""
+        q0, q = self.params[ORIENTATION], pose[3:7]
+        # the turn since t = 0: q q0^-1
+        w, x, y, z = (q[0] * q0[0] + q[1] * q0[1] + q[2] * q0[2] + q[3] * q0[3],
+                      -q[0] * q0[1] + q[1] * q0[0] - q[2] * q0[3] + q[3] * q0[2],
+                      -q[0] * q0[2] + q[1] * q0[3] + q[2] * q0[0] - q[3] * q0[1],
+                      -q[0] * q0[3] - q[1] * q0[2] + q[2] * q0[1] + q[3] * q0[0])
+        turned = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                           [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                           [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+        return pose[0:3] - turned @ (self.params[START] - self.params[TURN_CENTER])
+
+    def lever(self, vertices, pose):
+        """The largest lever (m) of ``vertices`` (n, 3, body frame) about
+        the turn's axis, the body at ``pose``."""
+        from .surfaces import quaternion_matrix
+
+        x = pose[0:3] + vertices @ quaternion_matrix(pose[3:7]).T
+        return float(np.linalg.norm(np.cross(self.turn_axis, x - self.center_of(pose)),
+                                    axis=1).max())
+
     def place(self, pose, t):
         """On the path at ``t``, turned by the angle last settled to."""
         super().place(pose, t)

@@ -49,7 +49,7 @@ shape = {{ type = "box", size = [{h}, {h}, {h}] }}
 position = [{r}, {half}, 0.0]
 motion = "{motion}"
 [body.path]
-rotation = {{ axis = [0.0, 0.0, 1.0], rate = {rate}, center = [0.0, 0.0, 0.0], torque = {torque} }}
+rotation = {{ axis = {axis}, rate = {rate}, center = [0.0, 0.0, 0.0], torque = {torque} }}
 {extra}
 [[surface]]
 name = "floor"
@@ -61,11 +61,11 @@ size = 1.0
 
 
 def lever_scene(tmp_path, h=1e-3, r=0.05, torque=-1.0, rate=0.0, motion="guided", extra="",
-                side=1.0, mode="quasi-static", duration=0.05, history=6):
+                side=1.0, mode="quasi-static", duration=0.05, history=6, axis="[0.0, 0.0, 1.0]"):
     text = HEADER.format(mode=mode, duration=duration, history=history,
                          stiffness=STIFFNESS) + LEVER.format(
         h=h, r=r, half=0.5 * h, torque=torque, rate=rate, motion=motion, extra=extra,
-        side=side)
+        side=side, axis=axis)
     path = tmp_path / "lever.toml"
     path.write_text(text)
     return path
@@ -247,6 +247,9 @@ def loop_scene_without(tmp_path):
     (dict(torque=0.0), "torque"),
     # the torque turns it off the plane: nothing carries it
     (dict(torque=1.0), "path.rotation.torque"),
+    # about the plane's normal (a braked disc): no lever, only friction
+    # could carry it, and friction is not in the balance
+    (dict(axis="[0.0, 1.0, 0.0]"), "path.rotation.torque"),
 ])
 def test_bad_torques_are_refused_with_the_key(tmp_path, change, key):
     with pytest.raises(SceneError, match=key.replace(".", r"\.")):
