@@ -122,7 +122,7 @@ def test_two_feet_share_the_torque_as_stiffness_times_lever_squared(tmp_path):
     feet.export(tmp_path / "feet.stl")
     text = (HEADER.format(mode="quasi-static", duration=0.03, history=4, stiffness=STIFFNESS)
             + LEVER.format(h=h, r=0.0, half=0.0, torque=torque, rate=0.0, motion="guided",
-                           extra="", side=1.0)).replace(
+                           extra="", side=1.0, axis="[0.0, 0.0, 1.0]")).replace(
         'shape = { type = "box", size = [0.001, 0.001, 0.001] }', 'mesh = "feet.stl"')
     path = tmp_path / "feet.toml"
     path.write_text(text)
