@@ -61,10 +61,11 @@ size = 1.0
 
 
 def lever_scene(tmp_path, h=1e-3, r=0.05, torque=-1.0, rate=0.0, motion="guided", extra="",
-                side=1.0, mode="quasi-static", duration=0.05, history=6, axis="[0.0, 0.0, 1.0]"):
+                side=1.0, mode="quasi-static", duration=0.05, history=6, axis="[0.0, 0.0, 1.0]",
+                lift=0.0):
     text = HEADER.format(mode=mode, duration=duration, history=history,
                          stiffness=STIFFNESS) + LEVER.format(
-        h=h, r=r, half=0.5 * h, torque=torque, rate=rate, motion=motion, extra=extra,
+        h=h, r=r, half=0.5 * h + lift, torque=torque, rate=rate, motion=motion, extra=extra,
         side=side, axis=axis)
     path = tmp_path / "lever.toml"
     path.write_text(text)
@@ -250,6 +251,9 @@ def loop_scene_without(tmp_path):
     # about the plane's normal (a braked disc): no lever, only friction
     # could carry it, and friction is not in the balance
     (dict(axis="[0.0, 1.0, 0.0]"), "path.rotation.torque"),
+    # a face 10 mm off the plane: it would have to turn by 0.2 rad to touch,
+    # beyond a small turn's balance (a gear out of mesh)
+    (dict(extra="", side=1.0, h=1e-3, r=0.05, lift=1e-2), "path.rotation.torque"),
 ])
 def test_bad_torques_are_refused_with_the_key(tmp_path, change, key):
     with pytest.raises(SceneError, match=key.replace(".", r"\.")):

@@ -44,6 +44,11 @@ SETTLED_ANGLE = 1e-7
 #: passes of the linearised solve at most (the start of a run, from a guess
 #: far off, takes a few; a step one or two)
 MAX_PASSES = 12
+#: a pass that would turn the body by more than this (rad) finds no balance:
+#: the linearisation holds for small turns, and a pair that touches only
+#: that far off (a gear out of mesh, its mate's faces seen from afar) is not
+#: a contact that carries the torque
+MAX_TURN = 0.1
 
 
 @njit(cache=True)
@@ -174,19 +179,23 @@ def settle_turn(body_vertices, pose, params, terms, t, dt, buffer, planes, verte
     left, until one turns it by less than :data:`SETTLED_ANGLE`. Adds the
     angle to ``params[SETTLED]`` and, if ``dt`` > 0, its rate over the step
     to the angular velocity. Returns the angle (rad), NaN if no contact
-    carries the torque (``pose`` then as the passes before left it)."""
+    carries the torque, a pass would turn it by more than :data:`MAX_TURN`
+    or :data:`MAX_PASSES` do not settle it (``pose`` then as the passes
+    before left it)."""
     axis = params[TURN_AXIS]
     center = turn_center(params, terms, t, buffer)
     total = 0.0
     for _ in range(MAX_PASSES):
         angle = balance_angle(body_vertices, pose, axis, center, planes, vertex_planes, active,
                               area, law, params[CARRIED], scratch)
-        if not np.isfinite(angle):
+        if not abs(angle) <= MAX_TURN:
             return np.nan
         turn_pose(pose, axis, center, angle)
         total += angle
         if abs(angle) < SETTLED_ANGLE:
             break
+    else:
+        return np.nan                    # the passes did not settle
     params[SETTLED] += total
     if dt > 0.0:
         for j in range(3):
