@@ -21,6 +21,8 @@ from meshwear.model import build_model, initial_state
 from meshwear.scene import SceneError, load_scene
 from meshwear.simulate import run, run_scene
 
+from cases import EXAMPLES
+
 #: N/m³, the Winkler foundation
 STIFFNESS = 1e12
 
@@ -208,16 +210,28 @@ def test_the_balance_kernel_agrees_with_its_numpy_twin(tmp_path):
 
 
 def test_the_compiled_loop_matches_the_python_reference(tmp_path):
-    """A box turning at 1 rad/s about an axis that keeps it on the plane
-    ... held against its torque: both steppers give the same numbers."""
-    path = lever_scene(tmp_path, duration=0.1, history=11)
-    states = []
+    """The spur pair of examples/gear_pair_torque_quasi_static.toml (on a
+    coarser mesh of its gear), the pinion turning at 100 rad/s in balance
+    under its torque, 40 steps, both wearing: the compiled loop and the
+    Python reference give the same numbers, bit for bit."""
+    from test_example_outputs import _coarse_gear
+
+    gear = str(_coarse_gear(tmp_path))
+    scene = load_scene(EXAMPLES / "gear_pair_torque_quasi_static.toml").set({
+        "body[0].mesh": gear, "surface[0].mesh": gear, "run.duration": 40 * 5e-5,
+        "run.frames": 0, "run.history": 5, "wear.acceleration": "none",
+        "wear.coefficient": 1e-12})
+    states, settled = [], []
     for compiled in (True, False):
-        model = build_model(load_scene(path))
+        model = build_model(scene)
         states.append(run(model, initial_state(model), compiled=compiled))
+        settled.append(model.bodies[0].motion.settled)
     a, b = states[0].bodies[0], states[1].bodies[0]
+    assert a.normal_force.sum() > 0.0 and a.wear_depth.max() > 0.0
     np.testing.assert_array_equal(a.pose, b.pose)
     np.testing.assert_array_equal(a.normal_force, b.normal_force)
+    np.testing.assert_array_equal(a.wear_depth, b.wear_depth)
+    assert settled[0] == settled[1] != 0.0
 
 
 def test_only_a_scene_with_a_torque_compiles_the_torque_balance(tmp_path):
