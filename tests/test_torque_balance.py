@@ -302,3 +302,33 @@ def test_a_worn_lever_keeps_its_torque_through_cycle_jumps(tmp_path):
     # (abs=0: pytest.approx's default absolute 1e-12 would pass any volume)
     assert volumes["none"] > 0.9 * k * (-torque / r) * 4 * amplitude * cycles  # it wore
     assert volumes["cycle_jump"] == pytest.approx(volumes["none"], rel=2e-3, abs=0.0)
+
+
+def test_a_turning_body_resumes_to_the_same_wear(tmp_path):
+    """The worn lever with cycle jumps, stopped half way at a checkpoint and
+    resumed in a new model: the angle it settled to comes back with the
+    checkpoint, and the run ends with the uninterrupted one's wear
+    (docs/outputs.md, "Checkpoints": 1e-9)."""
+    from meshwear import checkpoint
+    from test_resume import _KillAt, _Stop
+
+    extra = "oscillation = { axis = [0.0, 0.0, 1.0], amplitude = 1e-4, frequency = 10.0 }"
+    text = lever_scene(tmp_path, extra=extra, duration=30.0, history=31).read_text().replace(
+        "dt = 0.01", "dt = 0.0025").replace(
+        "coefficient = 0.0", 'coefficient = 1e-12\nacceleration = "cycle_jump"')
+    path = tmp_path / "resumed_lever.toml"
+    path.write_text(text)
+    model = build_model(load_scene(path))
+    full = run(model, initial_state(model))
+    saver = checkpoint.Checkpointer(tmp_path, every=0.0)
+    model = build_model(load_scene(path))
+    with pytest.raises(_Stop):
+        run(model, initial_state(model), observers=[_KillAt(17.0)], checkpoint=saver)
+    model = build_model(load_scene(path))
+    resumed = initial_state(model)
+    checkpoint.load(saver.path, model, resumed)
+    assert 0.0 < resumed.time <= 17.0 and model.bodies[0].motion.settled != 0.0
+    run(model, resumed)
+    w, w_full = resumed.bodies[0].wear_depth, full.bodies[0].wear_depth
+    assert w_full.max() > 0.0
+    assert np.abs(w - w_full).max() <= 1e-9 * w_full.max()
