@@ -332,3 +332,31 @@ def test_a_turning_body_resumes_to_the_same_wear(tmp_path):
     w, w_full = resumed.bodies[0].wear_depth, full.bodies[0].wear_depth
     assert w_full.max() > 0.0
     assert np.abs(w - w_full).max() <= 1e-9 * w_full.max()
+
+
+def test_turn_pose_agrees_with_scipy_rotations():
+    """turn_pose (the settled turn of a pose about an axis through a point)
+    against scipy's rotations: the centre of mass turned about the point,
+    the orientation composed with the turn."""
+    from scipy.spatial.transform import Rotation
+
+    from meshwear.kernels.turn_balance import turn_pose
+
+    rng = np.random.default_rng(7)
+    for _ in range(10):
+        pose = np.zeros(13)
+        pose[0:3] = rng.normal(size=3)
+        q = rng.normal(size=4)
+        pose[3:7] = q / np.linalg.norm(q)
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        center, angle = rng.normal(size=3), rng.uniform(-1.0, 1.0)
+        turned = pose.copy()
+        turn_pose(turned, axis, center, angle)
+        turn = Rotation.from_rotvec(angle * axis)
+        np.testing.assert_allclose(turned[0:3], center + turn.apply(pose[0:3] - center),
+                                   rtol=0, atol=1e-14)
+        w, x, y, z = pose[3:7]
+        expected = (turn * Rotation.from_quat([x, y, z, w])).as_quat()     # x y z w
+        got = np.array([*turned[4:7], turned[3]])
+        assert min(np.abs(got - expected).max(), np.abs(got + expected).max()) < 1e-14
