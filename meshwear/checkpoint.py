@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .kernels.rigid import SETTLED, TURNING
 from .output.tables import replace_atomic
 from .scene import SceneError
 
@@ -86,6 +87,11 @@ def save(path, model, state, wall_time):
         # and whether it held every pair, as the whole run does)
         arrays[f"body{k}_log_count"] = s.log_count
         arrays[f"body{k}_log_rows"] = np.array([len(s.log_index)])
+    for k, body in enumerate(model.bodies):
+        if body.motion.kind == TURNING:
+            # the angle a body under a torque last settled to: its next
+            # step starts from it (meshwear.kernels.turn_balance)
+            arrays[f"body{k}_settled"] = np.array([body.motion.settled])
     own = model.dynamics.get_state()
     if own is not None:
         # a mechanism's (MuJoCo's whole integration state): bit for bit on resuming
@@ -192,6 +198,8 @@ def load(path, model, state):
                 getattr(s, name)[...] = data[f"body{k}_{name}"]
             s.active = data[f"body{k}_active"].astype(np.int64)
             s.active_wear = data[f"body{k}_active_wear"].copy()
+            if f"body{k}_settled" in data:
+                model.bodies[k].motion.params[SETTLED] = float(data[f"body{k}_settled"][0])
             if f"body{k}_log_count" in data:
                 s.log_count[...] = data[f"body{k}_log_count"]
                 rows = int(data[f"body{k}_log_rows"][0])

@@ -337,6 +337,11 @@ def _check(scene_path, overrides=()):
         mass = f"{b.mass:.6g} kg" if np.isfinite(b.mass) else "n/a (open mesh, not integrated)"
         print(f"  body {b.name!r}: {len(b.tributary_area)} contact points, {len(b.faces)} faces, "
               f"mass {mass}, motion {config.motion}")
+        turn = config.path.rotation if config.path is not None else None
+        if turn is not None and turn.torque is not None:
+            print(f"    turning at {turn.rate:g} rad/s about {list(turn.axis)} through "
+                  f"{list(turn.center)}, in balance under {turn.torque:g} N·m (settled at the "
+                  f"start by {1e3 * b.motion.settled:.4g} mrad)")
         if b.refinement:
             print(f"    {describe_refinement(b.refinement)}")
         print(f"    active-set margin {b.margin:.3g} m: {b.margin_reason}")

@@ -45,7 +45,7 @@ import numpy as np
 from .elastic import equivalent_depth
 from .kernels.balance import implicit_step
 from .kernels.contact import FACING
-from .motion import BalancedMotion, GuidedMotion, MechanismMotion
+from .motion import BalancedMotion, GuidedMotion, MechanismMotion, TurningMotion
 from .surfaces import quaternion_matrix, vertex_feet
 
 
@@ -190,8 +190,9 @@ def measure(model, body, s, rate, start=None, window=1):
     motion = body.motion
     guided = isinstance(motion, (BalancedMotion, GuidedMotion)) and model.slots > 0
     rider = isinstance(motion, MechanismMotion) and model.slots > 0
+    turning = isinstance(motion, TurningMotion) and model.slots > 0
     beta, carried = np.zeros(len(rate)), 0.0
-    if guided or rider:
+    if guided or rider or turning:
         # a vertex that faces no surface at the end of the cycle was pressed,
         # while in contact, against its own outward normal
         facing = np.where(np.any(normal != 0.0, axis=1)[:, None], normal,
@@ -215,6 +216,19 @@ def measure(model, body, s, rate, start=None, window=1):
         beta = facing @ motion.axis
         carried = (motion.carried if isinstance(motion, BalancedMotion)
                 else -float(motion.params[19:22] @ motion.axis) / motion.params[0])
+    elif turning:
+        # a body turning under a torque: its move is a turn, the penetration
+        # each vertex loses per radian n . (a x r) (docs/model.md,
+        # "Quasi-static mode"); the move is counted as the arc at the
+        # body's largest lever (m, beta and the torque over that lever), so
+        # the jump's bounds on moves read it as a length
+        guided = True
+        lever = motion.lever(s.vertices, s.pose)
+        x = s.pose[0:3] + s.vertices[index] @ quaternion_matrix(s.pose[3:7]).T
+        arm = np.cross(motion.turn_axis, x - motion.center_of(s.pose))
+        beta = np.einsum("ij,ij->i", facing, arm) / lever
+        carried = motion.carried / lever
+        motion.jump_lever = lever
     elif rider:
         # a part on a mechanism body: the mechanism holds its contact force
         # at the end of the cycle (a press, a joint's reaction) while it

@@ -22,6 +22,7 @@ from .kernels.counter_wear import settle_counter, wear_counter
 from .kernels.laws import code_of
 from .kernels.nearest import face_frames
 from .motion import (BalancedMotion, FixedMotion, FreeMotion, GuidedMotion, MechanismMotion, Path,
+                     TurningMotion,
                      PrescribedMotion)
 from .scene import SceneError
 from .stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_stiffness
@@ -416,6 +417,14 @@ def build_model(scene):
                                  f"no surface can carry the load of body {config.name!r} along "
                                  f"{list(config.path.free_axis)} (the load pulls it off every "
                                  "surface, or no surface faces it along that axis)")
+        if isinstance(b.motion, TurningMotion):
+            if not b.motion.settle(b.initial_pose, b.reference_vertices, b.area_vectors,
+                                   plane_array, vertex_planes,
+                                   all_vertices(len(b.reference_vertices)), law):
+                raise SceneError(scene.source, f"body[{j}].path.rotation.torque",
+                                 f"no contact can carry the torque of body {config.name!r} "
+                                 f"about {list(config.path.rotation.axis)} (no surface it "
+                                 "touches, turning that way, has a lever about the axis)")
     # a turning mesh is static in shape if it is a surface of revolution
     # about its axis, against the smallest active-set margin
     margin = min(surfaces.margin_of(scene, b) for b in bodies)
@@ -660,6 +669,19 @@ def _build_body(scene, index, body, surface_set, mechanism=None, loaded=None):
     path = Path(body.path)
     if body.motion == "free":
         motion = FreeMotion(mass, inertia, acceleration)
+    elif body.path is not None and body.path.rotation is not None \
+            and body.path.rotation.torque is not None:
+        # a guided body under a torque (the scene allows nothing else)
+        if scene.run.mode != "quasi-static":
+            raise SceneError(scene.source, f"{key}.path.rotation.torque",
+                             "applies in run.mode = \"quasi-static\" only (a dynamic run "
+                             "would integrate the turn: give the body a mass and use a "
+                             "[mechanism])")
+        if scene.contact.model == "half-space":
+            raise SceneError(scene.source, f"{key}.path.rotation.torque",
+                             "not supported with contact.model = \"half-space\" (its patch "
+                             "balances a load along the normal only)")
+        motion = TurningMotion(pose[0:3].copy(), path, body.path.rotation.torque)
     elif body.motion == "guided" and scene.run.mode == "quasi-static":
         motion = BalancedMotion(pose[0:3].copy(), path, body.path.free_axis,
                                 mass * acceleration @ np.asarray(body.path.free_axis, float))

@@ -16,7 +16,9 @@ Every motion implements
     The degrees of freedom integrated in time: ``"all"``, ``"axis"`` or ``None``.
 
 In quasi-static runs, :class:`BalancedMotion` (a guided body) also has
-``settle``, which puts the body where its contacts carry its load.
+``settle``, which puts the body where its contacts carry its load, and
+:class:`TurningMotion` (a guided body turning under a torque) one that
+turns it to where its contacts carry the torque.
 """
 
 import numpy as np
@@ -24,9 +26,10 @@ import numpy as np
 from .kernels.balance import balance_offset
 from .kernels.rigid import (ACCELERATION, AXIS, BALANCED, CARRIED, CIRCLE, FIXED, FREE, GUIDED,
                             INERTIA, INVERSE_INERTIA, INVERSE_MASS, MOTION_PARAMS, OSCILLATION,
-                            ORIENTATION, PRESCRIBED, START, STEADY, TURN_AXIS, TURN_CENTER,
-                            TURN_RATE, advance_free_motion, advance_motion, path_point,
-                            place_motion)
+                            ORIENTATION, PRESCRIBED, SETTLED, START, STEADY, TURN_AXIS,
+                            TURN_CENTER, TURN_RATE, TURNING, advance_free_motion, advance_motion,
+                            path_point, place_motion)
+from .kernels.turn_balance import place_settled, settle_turn
 
 
 class Path:
@@ -220,6 +223,80 @@ class BalancedMotion(Motion):
         for j in range(3):
             pose[j] += z * self.axis[j]
         return True
+
+
+class TurningMotion(Motion):
+    """Quasi-static guided body under a torque: it follows ``start +
+    path(t)`` and its path's steady turn, and turns besides by the settled
+    angle at which its contacts' normal forces carry the applied ``torque``
+    (N·m about the turn's axis, right-handed: positive turns it the way a
+    positive rate does), found by
+    :func:`meshwear.kernels.turn_balance.settle_turn`. No inertia, no
+    damping. The settled angle is kept in ``params[SETTLED]`` (the next
+    step starts from it). Call :meth:`set_turn` before use."""
+
+    kind = TURNING
+
+    def __init__(self, start, path, torque):
+        #: torque the contacts must carry about the axis (N·m): params[CARRIED]
+        super().__init__(path, start, carried=-float(torque))
+        self.scratch = np.zeros((2, 0))
+
+    @property
+    def carried(self):
+        return self.params[CARRIED]
+
+    @property
+    def settled(self):
+        """The angle (rad) the body last settled to, beyond its path's turn."""
+        return float(self.params[SETTLED])
+
+    ensure_scratch = BalancedMotion.ensure_scratch
+
+    @property
+    def turn_axis(self):
+        return self.params[TURN_AXIS]
+
+    def center_of(self, pose):
+        """(3,) the point the turn's axis passes through with the body at
+        ``pose`` (m): the centre of mass less its offset from the axis's
+        place at t = 0, turned as the body has turned since."""
+        q0, q = self.params[ORIENTATION], pose[3:7]
+        # the turn since t = 0: q q0^-1
+        w, x, y, z = (q[0] * q0[0] + q[1] * q0[1] + q[2] * q0[2] + q[3] * q0[3],
+                      -q[0] * q0[1] + q[1] * q0[0] - q[2] * q0[3] + q[3] * q0[2],
+                      -q[0] * q0[2] + q[1] * q0[3] + q[2] * q0[0] - q[3] * q0[1],
+                      -q[0] * q0[3] - q[1] * q0[2] + q[2] * q0[1] + q[3] * q0[0])
+        turned = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                           [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                           [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+        return pose[0:3] - turned @ (self.params[START] - self.params[TURN_CENTER])
+
+    def lever(self, vertices, pose):
+        """The largest lever (m) of ``vertices`` (n, 3, body frame) about
+        the turn's axis, the body at ``pose``."""
+        from .surfaces import quaternion_matrix
+
+        x = pose[0:3] + vertices @ quaternion_matrix(pose[3:7]).T
+        return float(np.linalg.norm(np.cross(self.turn_axis, x - self.center_of(pose)),
+                                    axis=1).max())
+
+    def place(self, pose, t):
+        """On the path at ``t``, turned by the angle last settled to."""
+        super().place(pose, t)
+        place_settled(pose, self.params, self.path.terms, float(t), self.path.buffer)
+
+    def settle(self, pose, vertices, area_vectors, planes, vertex_planes, active, law, t=0.0,
+               dt=0.0):
+        """Turn ``pose`` (placed at ``t``) to the torque balance, its angular
+        velocity given the rate of that turn over ``dt`` (if > 0); False if
+        no contact can carry the torque (arrays as for
+        :func:`meshwear.kernels.balance.balance_offset`)."""
+        scratch = self.ensure_scratch(len(active) * (planes.shape[0] + vertex_planes.shape[0]))
+        angle = settle_turn(vertices, pose, self.params, self.path.terms, float(t), float(dt),
+                            self.path.buffer, planes, vertex_planes, active, area_vectors, law,
+                            scratch)
+        return bool(np.isfinite(angle))
 
 
 class FixedMotion(Motion):

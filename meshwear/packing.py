@@ -3,7 +3,7 @@
 
 import numpy as np
 
-from .kernels.rigid import BALANCED
+from .kernels.rigid import BALANCED, TURNING
 
 
 def body_arrays(model, body, s):
@@ -18,7 +18,7 @@ def body_arrays(model, body, s):
 def motion_arrays(model, body, s):
     """The ``motion`` tuple of :mod:`meshwear.kernels.loop`."""
     m = body.motion
-    if m.kind == BALANCED and model.quasi_static:
+    if m.kind in (BALANCED, TURNING) and model.quasi_static:
         scratch = m.ensure_scratch(len(s.active) * model.slots)
     else:
         scratch = np.zeros((2, 0))

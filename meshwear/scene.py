@@ -397,16 +397,25 @@ class PathConfig:
 @dataclass(frozen=True, kw_only=True)
 class RotationConfig:
     """Steady rotation of a surface or a body's path: unit ``axis``, ``rate``
-    (rad/s), ``center`` (m, a body's carried along its path)."""
+    (rad/s), ``center`` (m, a body's carried along its path). ``torque``
+    (N·m about ``axis``, right-handed), on a guided body's path only: the
+    body turns, besides ``rate``, to where its contacts carry that torque
+    (quasi-static runs; docs/model.md, "Quasi-static mode")."""
 
     axis: tuple
     rate: float
     center: tuple = (0.0, 0.0, 0.0)
+    torque: float | None = None
 
     def __post_init__(self):
         _set(self, "axis", _direction)
         _set(self, "rate", _real)
         _set(self, "center", _place)
+        _set_optional(self, "torque", _real)
+        if self.torque == 0.0:
+            raise SceneError("", "torque", "0: a body under no torque has no balance about its "
+                             "axis (it floats between its contacts); give a torque or leave "
+                             "the key out")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -510,13 +519,29 @@ class BodyConfig:
                                          "use motion = \"guided\" or \"prescribed\"")
         if self.motion in ("guided", "prescribed") and self.path is None:
             raise SceneError("", "path", f"missing; a {self.motion} body needs a path")
-        if self.motion == "guided" and self.path.free_axis is None:
+        torque = (self.path is not None and self.path.rotation is not None
+                  and self.path.rotation.torque is not None)
+        if torque and self.motion != "guided":
+            raise SceneError("", "path.rotation.torque", f"applies to guided bodies only; a "
+                             f"{self.motion} body's turn is set, not balanced")
+        if torque and self.path.free_axis is not None:
+            raise SceneError("", "path.rotation.torque", "a body balanced under a torque "
+                             "turns about its axis only: leave path.free_axis out (a balance "
+                             "along an axis and about one at once is not supported)")
+        if self.motion == "guided" and self.path.free_axis is None and not torque:
             raise SceneError("", "path.free_axis", "missing; a guided body needs the axis "
-                                                   "along which it moves freely")
+                                                   "along which it moves freely (or "
+                                                   "path.rotation.torque)")
+        if torque:
+            for key in ("velocity", "angular_velocity", "force"):
+                if any(getattr(self, key)):
+                    raise SceneError("", key, "does not apply to a body turning under "
+                                     "path.rotation.torque (its path sets its motion, the "
+                                     "torque its turn)")
         if self.motion == "prescribed" and self.path.free_axis is not None:
             raise SceneError("", "path.free_axis", "applies to guided bodies only; a "
                                                    "prescribed body follows its path exactly")
-        if self.motion == "guided":
+        if self.motion == "guided" and not torque:
             if any(self.angular_velocity):
                 raise SceneError("", "angular_velocity", "does not apply to a guided body "
                                                          "(it does not rotate)")
@@ -595,6 +620,9 @@ class SurfaceConfig:
         if self.path is not None and self.path.rotation is not None:
             raise SceneError("", "path.rotation", "a surface turns by its own rotation key, "
                                                   "not its path's")
+        if self.rotation is not None and self.rotation.torque is not None:
+            raise SceneError("", "rotation.torque", "applies to a guided body's "
+                             "path.rotation only; a surface turns at its rate")
         own = set(SURFACE_KEYS[self.type])
         defaults = {f.name: f.default for f in dataclasses.fields(self)}
         for key in {k for keys in SURFACE_KEYS.values() for k in keys} - own:

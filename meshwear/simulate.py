@@ -19,6 +19,7 @@ from threadpoolctl import threadpool_limits
 from . import elastic, stepper, surfaces
 from .geometry import inverted_faces
 from .kernels.loop import deepest_penetration, impact_check, use_impact_room
+from .kernels.rigid import TURNING
 from .model import IMPACT_DEPTH, body_contact, settle_counters, wear_counters
 from .output.memory import MemoryHistory
 from .wear import run_cycle_jump
@@ -96,8 +97,11 @@ def _quasi_static_step(model, body, s, k):
         return
     settle = getattr(body.motion, "settle", None)
     if settle is not None:
+        # (a turning body's settle takes the step's time: its axis's place,
+        # and the rate of its turn)
+        when = dict(t=t, dt=model.dt) if body.motion.kind == TURNING else {}
         if not settle(s.pose, s.vertices, body.area_vectors, model.planes, s.vertex_planes,
-                      s.active, model.law):
+                      s.active, model.law, **when):
             raise no_balance(body, t)
         s.pose[7:10] = (s.pose[0:3] - before) / model.dt
         if surfaces.moved_since_refresh(model, body, s, t) >= s.cull[surfaces.CULL_MARGIN]:

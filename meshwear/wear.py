@@ -53,6 +53,8 @@ from . import jump_geometry, jumps
 from .kernels.contact import ANCHOR
 from .kernels.counter_wear import SPACING_FRACTION
 from .kernels.nearest import face_frames
+from .kernels.rigid import SETTLED
+from .motion import TurningMotion
 from .output import filled
 from .surfaces import contact_areas, quaternion_matrix, slot_normals
 
@@ -864,6 +866,11 @@ def _jump(model, state, before, rates, jump, results, measures=None, window=1):
         s.wear_depth += wear
         span = {name: (span[name], getattr(s, name).copy()) for name in JUMPED}
         span["shift"] = z * body.motion.axis if z else np.zeros(3)
+        if isinstance(body.motion, TurningMotion):
+            # its move is a turn, the arc at its largest lever (jumps.measure)
+            span["shift"] = np.zeros(3)
+            if z:
+                body.motion.params[SETTLED] += z / body.motion.jump_lever
         spans.append(span)
     state.step += jump * model.cycle_steps
     state.time = state.step * model.dt

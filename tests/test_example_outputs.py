@@ -46,6 +46,10 @@ TWO_BODY = {
     # meshes/make_gear.py: the example's own takes some 30 s to its first jump)
     "gear_pair.toml": {"run.duration": 5 * TURN, "run.dt": 1e-3, "wear.tolerance": 0.05,
                        "run.history": 41},
+    # (the same coarser gear; 100 rad/s)
+    "gear_pair_torque_quasi_static.toml": {"run.duration": 5 * 2.0 * np.pi / 100.0,
+                                           "run.dt": 1e-4, "wear.tolerance": 0.05,
+                                           "run.history": 41},
     "shaft_in_worn_bushing.toml": {
         "run.duration": 6 * TURN, "run.dt": 1e-3, "wear.acceleration": "cycle_jump",
         "body[0].shape": {"type": "cylinder", "radius": 0.005, "height": 0.005, "sections": 64},
@@ -95,7 +99,7 @@ def _coarse_gear(folder):
 def _settings(name, folder):
     if name in TWO_BODY:
         values = dict(TWO_BODY[name])
-        if name == "gear_pair.toml":
+        if name in ("gear_pair.toml", "gear_pair_torque_quasi_static.toml"):
             gear = str(_coarse_gear(folder))
             values.update({"body[0].mesh": gear, "surface[0].mesh": gear})
     else:

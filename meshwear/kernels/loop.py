@@ -47,8 +47,9 @@ from .contact import (BUILDS, PARALLEL_THRESHOLD, _named_copy, contact_parallel,
 from .counter import NAMES, PARALLEL_THRESHOLD as LOOKUP_THRESHOLD, fill_planes, fill_planes_for
 from .counter_wear import wear_counter
 from .frames import moved_since_refresh, plane_rows, step_motion, surface_frame
-from .rigid import (AXIS, BALANCED, CARRIED, FIXED, FREE, advance_free_motion,
+from .rigid import (AXIS, BALANCED, CARRIED, FIXED, FREE, TURNING, advance_free_motion,
                     advance_motion, place_motion)
+from .turn_balance import place_settled, settle_turn
 
 #: what :func:`advance_body` returns besides the step it reached
 DONE, REFRESH, FINISH, NO_BALANCE, TOO_DEEP, IMPACT = 0, 1, 2, 3, 4, 5
@@ -71,6 +72,10 @@ SERIAL_CONTACT, PARALLEL_CONTACT = contact_serial, contact_parallel
 DYNAMIC_ONLY = False
 #: a build for quasi-static runs only: the dynamic step is left out
 QUASI_STATIC_ONLY = False
+#: a build with the torque balance of turning bodies (kind TURNING,
+#: :mod:`meshwear.kernels.turn_balance`); only the scenes that have one
+#: compile it
+TURNS = False
 
 
 def _fill(body, planes, surfaces, t, buffer, rotation, frame):
@@ -242,7 +247,7 @@ def _advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes,
     rotation, frame = np.zeros((3, 3)), np.zeros((4, 3))
     placed = np.zeros(13)
     no_scale = np.zeros(0)
-    if (quasi_static and kind == BALANCED
+    if (quasi_static and (kind == BALANCED or (TURNS and kind == TURNING))
             and scratch.shape[1] < active.shape[0] * (plane_array.shape[0] + vertex_planes.shape[0])):
         return k, REFRESH                # Python grows the scratch
     while k < stop:
@@ -275,6 +280,9 @@ def _advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes,
         for j in range(13):
             placed[j] = pose[j]
         place_motion(kind, params, path_terms, buffer, placed, t)
+        if TURNS:
+            if kind == TURNING:
+                place_settled(placed, params, path_terms, t, buffer)
         for j in range(3):
             placed[7 + j] = (placed[j] - pose[j]) / dt
         # (the angular velocity is the path's: zero, or a steady turn's)
@@ -298,6 +306,18 @@ def _advance_body(k, stop, dt, quasi_static, cull_enabled, body, motion, planes,
             if cull_enabled and moved_since_refresh(pose, cull, radius, bounds, terms, t,
                                                     body[9], active, body[15], buffer) >= cull[0]:
                 return k, FINISH
+        if TURNS:
+            if kind == TURNING:
+                angle = settle_turn(vertices, pose, params, path_terms, t, dt, buffer,
+                                    plane_array, vertex_planes, active, area, law, scratch)
+                if not np.isfinite(angle):
+                    return k, NO_BALANCE
+                for j in range(3):
+                    pose[7 + j] = (pose[j] - saved[j]) / dt
+                if cull_enabled and moved_since_refresh(pose, cull, radius, bounds, terms, t,
+                                                        body[9], active, body[15],
+                                                        buffer) >= cull[0]:
+                    return k, FINISH
         _touch(body, plane_array)
         if WORN:
             if worn and not _wear_parts(body, surfaces, law, n_planes, t, buffer, rotation, frame,
@@ -317,7 +337,8 @@ GENERAL, ONE_PLANE, ONE_SURFACE = 0, 1, 2
 _LOOPS = {}
 
 
-def loop_build(kinds=ALL_KINDS, worn=True, threaded=True, case=None, dynamic=None, free=False):
+def loop_build(kinds=ALL_KINDS, worn=True, threaded=True, case=None, dynamic=None, free=False,
+               turns=False):
     """The build of :func:`advance_body` for the scenes that meet per-vertex
     counter-surfaces of ``kinds`` only (worn ones if ``worn``), have bodies
     large enough for the threaded kernels (``threaded``), call the contact
@@ -327,17 +348,20 @@ def loop_build(kinds=ALL_KINDS, worn=True, threaded=True, case=None, dynamic=Non
     defaults make the full one, :data:`advance_body`."""
     kinds = tuple(sorted(set(kinds)))
     worn = worn and bool(kinds)
-    key = (kinds, worn, threaded, case, dynamic, free)
+    turns = turns and dynamic is not True
+    key = (kinds, worn, threaded, case, dynamic, free, turns)
     if key in _LOOPS:
         return _LOOPS[key]
-    full = key == (ALL_KINDS, True, True, None, None, False)
+    full = key == (ALL_KINDS, True, True, None, None, False, False)
     parts = ["".join(k[0] for k in kinds) or "planes", "worn" if worn else "",
              "threads" if threaded else "serial",
              {None: "any", GENERAL: "general", ONE_PLANE: "plane", ONE_SURFACE: "surface"}[case],
-             {None: "", True: "dynamic", False: "quasi"}[dynamic], "free" if free else ""]
+             {None: "", True: "dynamic", False: "quasi"}[dynamic], "free" if free else "",
+             "turns" if turns else ""]
     name = "" if full else "_" + "_".join(p for p in parts if p)
     constants = dict(MESHES=bool(kinds), WORN=worn, PARALLEL=threaded,
                      DYNAMIC_ONLY=dynamic is True, QUASI_STATIC_ONLY=dynamic is False,
+                     TURNS=turns,
                      fill_planes=fill_planes_for(kinds, threaded))
     if case is not None:
         constants.update(SERIAL_CONTACT=BUILDS["contact_serial"][case],
@@ -365,7 +389,7 @@ def scene_build(model, dynamic=None):
         dynamic = not model.quasi_static
     case = (ONE_PLANE if (n_planes, n_surfaces) == (1, 0)
             else ONE_SURFACE if (n_planes, n_surfaces) == (0, 1) else GENERAL)
-    return dict(kinds=tuple(NAMES[s.kind] for s in per_vertex),
+    build = dict(kinds=tuple(NAMES[s.kind] for s in per_vertex),
                 worn=any(s.worn for s in per_vertex),
                 # (the threaded contact from its threshold of vertex-surface
                 # pairs, the threaded lookups from theirs of vertices)
@@ -374,6 +398,9 @@ def scene_build(model, dynamic=None):
                              for b in model.bodies),
                 case=case, dynamic=dynamic,
                 free=dynamic and all(b.motion.kind in (FREE, FIXED) for b in model.bodies))
+    if not dynamic and any(b.motion.kind == TURNING for b in model.bodies):
+        build["turns"] = True            # (only then: the others' builds keep their names)
+    return build
 
 
 def loop_for(model, dynamic=None):

@@ -169,15 +169,21 @@ def guided_step(pose, wrench, inverse_mass, acceleration, axis, start, terms, t,
 
 
 #: motion kinds of :func:`place_motion` and :func:`advance_motion`
-FIXED, FREE, GUIDED, PRESCRIBED, BALANCED = 0, 1, 2, 3, 4
-#: slots of a motion's ``params`` (40,): the mass terms, the free axis, the
-#: start, the load a balanced body carries, and a steady turn: the
+#: (TURNING: a quasi-static body on its path, turned about its turn's axis
+#: to a torque balance: :mod:`meshwear.kernels.turn_balance`)
+FIXED, FREE, GUIDED, PRESCRIBED, BALANCED, TURNING = 0, 1, 2, 3, 4, 5
+#: slots of a motion's ``params`` (41,): the mass terms, the free axis, the
+#: start, the load a balanced body carries (N along the free axis; a turning
+#: one's torque, N·m about the turn's axis), a steady turn: the
 #: orientation at t = 0, the turn's unit axis, its rate (rad/s, 0: none) and
-#: the point it turns about at t = 0 (carried along the path)
+#: the point it turns about at t = 0 (carried along the path), and the angle
+#: a turning body last settled to (rad, beyond its path's turn: a state the
+#: quasi-static step updates)
 INVERSE_MASS, INERTIA, INVERSE_INERTIA, ACCELERATION, AXIS, START, CARRIED = (
     0, slice(1, 10), slice(10, 19), slice(19, 22), slice(22, 25), slice(25, 28), 28)
 ORIENTATION, TURN_AXIS, TURN_RATE, TURN_CENTER = slice(29, 33), slice(33, 36), 36, slice(37, 40)
-MOTION_PARAMS = 40
+SETTLED = 40
+MOTION_PARAMS = 41
 
 
 @njit(cache=True)
@@ -226,7 +232,8 @@ def place_motion(kind, params, terms, buffer, pose, t):
     if kind == FIXED:
         for j in range(7, 13):
             pose[j] = 0.0
-    elif kind == PRESCRIBED:
+    elif kind == PRESCRIBED or kind == TURNING:
+        # (a turning body's settled angle is added by turn_balance.place_settled)
         place_on_path(pose, params[START], terms, np.zeros(3), 0.0, 0.0, t, buffer)
         turn(pose, params, np.zeros(3), t)
     elif kind == GUIDED or kind == BALANCED:
