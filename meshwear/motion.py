@@ -275,9 +275,10 @@ class TurningMotion(Motion):
     def lever(self, vertices, pose):
         """The largest lever (m) of ``vertices`` (n, 3, body frame) about
         the turn's axis, the body at ``pose``."""
-        from .surfaces import quaternion_matrix
+        from .kernels.contact import rotation_entries
 
-        x = pose[0:3] + vertices @ quaternion_matrix(pose[3:7]).T
+        R = np.array(rotation_entries(np.asarray(pose[3:7], float))).reshape(3, 3)
+        x = pose[0:3] + vertices @ R.T
         return float(np.linalg.norm(np.cross(self.turn_axis, x - self.center_of(pose)),
                                     axis=1).max())
 
