@@ -324,11 +324,19 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=
     return EXIT_OK
 
 
+#: the ratio of two meshes' edge lengths where they touch from which
+#: ``check`` gives notice (docs/model.md, "Worn counter-surfaces": a 2:1
+#: pad on a flat wore 84 % stripes; a counter coarser than twice the body's
+#: spacing does not spread its wear)
+SPACING_RATIO = 2.0
+
+
 def _check(scene_path, overrides=()):
     import numpy as np
 
     from .remesh import describe_refinement
 
+    started = time.perf_counter()        # the estimate's trial answers within 30 s of this
     scene, model, limit = _prepare(scene_path, overrides)
     print(f"scene {scene.source}: ok (format 1, mode {scene.run.mode})")
     for key, value in overrides:
@@ -366,9 +374,11 @@ def _check(scene_path, overrides=()):
         print(f"  cycle jumping: {model.cycle_steps} steps per cycle, {cycles:.6g} cycles, "
               f"{scene.wear.jump} jumps, tolerance {scene.wear.tolerance:g}; outputs inside "
               "jumps are filled from them")
+    for line in _spacing_notices(model, state):
+        print(f"  notice: {line}")
     from .estimate import estimate_run
 
-    e = estimate_run(model, state)
+    e = estimate_run(model, state, started)
     full = "" if not model.cycle_steps else (
         "with cycle jumping " if e.trial_covered >= model.n_steps else
         f"with cycle jumps growing as in a {e.trial_time:.2g} s trial " if e.trial_jumps else
@@ -379,7 +389,45 @@ def _check(scene_path, overrides=()):
           f"{e.active} of {e.vertices} vertices within reach of a surface), "
           f"writing {e.writing:.3g} s ({len(model.frame_steps)} frames, "
           f"{len(model.sample_steps)} history rows)")
+    if e.cycles:
+        (low, high), (cycles, few, many) = e.range, e.cycles
+        print(f"  run time range with cycle jumping {low:.3g}–{high:.3g} s ({high / low:.2g}x), "
+              f"{few:.0f}–{many:.0f} of {model.n_steps / model.cycle_steps:.6g} cycles resolved "
+              f"(estimate {cycles:.0f}): the jumps after the trial from the fastest to the "
+              "slowest trend its bounded jumps allow")
     return EXIT_OK
+
+
+def _spacing_notices(model, state):
+    """One line per body and mesh surface whose edge lengths where they
+    touch differ by :data:`SPACING_RATIO` or more."""
+    from .remesh import spacing_ratio
+    from .surfaces import quaternion_matrix
+
+    lines = []
+    for body, s in zip(model.bodies, state.bodies):
+        world = s.pose[0:3] + s.vertices @ quaternion_matrix(s.pose[3:7]).T
+        for surface in model.surfaces.slots:
+            faces = getattr(surface, "faces", None)
+            if faces is None or not hasattr(surface, "world_vertices"):
+                continue                 # an analytic surface: no spacing of its own
+            spacing = spacing_ratio(world, body.faces, s.active,
+                                    surface.world_vertices(surface.vertices, 0.0), faces)
+            if spacing is None:
+                continue
+            h_body, h_counter = spacing
+            ratio = max(h_body, h_counter) / min(h_body, h_counter)
+            if ratio >= SPACING_RATIO:
+                finer = h_counter < h_body
+                why = "" if not getattr(surface, "worn", False) else (
+                    "; a worn counter finer than the body wears in tracks a body vertex apart"
+                    if finer else "; a worn counter coarser than the body smooths its wear "
+                    "over its own spacing") + " (docs/model.md, \"Worn counter-surfaces\")"
+                lines.append(
+                    f"body {body.name!r} ({h_body * 1e6:.3g} µm edges where it touches) and "
+                    f"mesh surface {surface.name!r} ({h_counter * 1e6:.3g} µm there) differ "
+                    f"{ratio:.2g}:1 in resolution{why}")
+    return lines
 
 
 def _slot_configs(scene, model):

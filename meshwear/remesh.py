@@ -390,3 +390,36 @@ def describe_refinement(info):
     return (text + f"; facet sag {info['sag']:.2g} m where refined "
             f"({info['sag'] / info['resolution']:.2g} of the resolution), "
             f"{info['sag_elsewhere']:.2g} m elsewhere")
+
+
+def spacing_near(vertices, faces, low, high):
+    """Median edge length (m) of the edges of ``faces`` with both ends inside
+    the box ``low``..``high`` (3,) of ``vertices`` (n, 3), None if none: a
+    mesh's spacing where another touches it (:func:`contact_spacings`)."""
+    inside = np.all((vertices >= low) & (vertices <= high), axis=1)
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    edges = edges[inside[edges].all(axis=1)]
+    if not len(edges):
+        return None
+    return float(np.median(np.linalg.norm(vertices[edges[:, 0]] - vertices[edges[:, 1]],
+                                          axis=1)))
+
+
+def spacing_ratio(body_vertices, body_faces, active, counter_vertices, counter_faces):
+    """``(h_body, h_counter)``, the median edge lengths (m) of a body's
+    contact (its ``active`` vertices, world frame) and of a counter mesh
+    under it (world frame: its vertices within the body's contact box,
+    widened by two of the body's edges), or None where either has no edge
+    there. A worn counter much finer or coarser than the body there wears
+    in tracks or smooths the body's wear (docs/model.md, "Worn
+    counter-surfaces")."""
+    if not len(active):
+        return None
+    points = body_vertices[active]
+    low, high = points.min(axis=0), points.max(axis=0)
+    h_body = spacing_near(body_vertices, body_faces, low, high)
+    if h_body is None:
+        return None
+    h_counter = spacing_near(counter_vertices, counter_faces, low - 2 * h_body,
+                             high + 2 * h_body)
+    return None if h_counter is None else (h_body, h_counter)
