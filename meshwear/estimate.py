@@ -40,8 +40,11 @@ FIRST_JUMP_MEASUREMENTS = 3
 #: wall time (s) from the start of ``meshwear check`` (or of
 #: :func:`estimate_run`) by which the jump trial ends at the latest, when
 #: longer than JUMP_TRIAL_LONGEST: a trial whose range is wider than
-#: WIDEST goes on until then (the answer within 30 s, docs/performance.md)
-ANSWER_SECONDS = 24.0
+#: WIDEST goes on until then (the answer within 30 s, docs/performance.md:
+#: the interpreter's start and imports come before, and the trial looks at
+#: the clock only every output or 2 000 steps; at 24 s the CAD part's check
+#: answered in 30.4 s on a busy machine)
+ANSWER_SECONDS = 20.0
 #: the range (high / low) a jump trial with BOUNDED_JUMPS stops at
 WIDEST = 3.0
 #: the confidence the range's trends of bounded jumps are taken at, either
@@ -269,21 +272,23 @@ def _cycles_left(position, total, window, settle, jump, trend):
     """Cycles the run resolves from cycle ``position`` to ``total`` by the
     controller's rule: a measurement of ``window`` cycles, then a jump
     (``GROWTH J + 1`` from the last ``jump``, up to ``trend``'s ``a p^b``,
-    at least one cycle; None: growth alone, "none": no jump) and ``settle``
-    cycles after it."""
+    at least one cycle; None: growth alone, "none": no jump) that leaves
+    the run's last cycle resolved, and ``settle`` cycles after it."""
     from .wear import GROWTH
 
     cycles = 0.0
     if trend == "none":
         return max(0.0, total - position)
     while position < total:
+        cycles += min(window, total - position)     # (the run's last cycle may be cut short)
         position += window
-        cycles += window
         jump = GROWTH * jump + 1.0
         if trend is not None:
             jump = max(1.0, min(jump, _jump_at(trend, position)))
-        if position < total:
-            position += jump + settle
+        # the run ends with a resolved cycle (the bound "end")
+        taken = min(jump, math.ceil(total - position) - 1.0)
+        if taken >= 1.0:
+            position += taken + settle
             cycles += settle
     return cycles
 

@@ -25,10 +25,11 @@ from meshwear.wear import GROWTH
 @pytest.mark.parametrize("total", [1.0, 5.0, 100.0, 1000.0, 12345.0])
 def test_jumps_growing_alone_resolve_a_cycle_per_doubling(total):
     # jumps 1, 3, 7, ... (GROWTH J + 1 from 0) after one cycle each: the
-    # k-th measurement ends at 2^(k+1) - 2 cycles, the run at the first
-    # that reaches ``total``
+    # k-th measurement ends at cycle 2^k - 1, and the jump that would pass
+    # the end stops a cycle short of it, which is resolved (the bound "end"):
+    # ceil(log2(total + 1)) measurements in all
     assert GROWTH == 2.0
-    expected = max(1, math.ceil(math.log2(total + 2.0)) - 1)
+    expected = math.ceil(math.log2(total + 1.0))
     assert _cycles_left(0.0, total, 1.0, 0, 0.0, None) == expected
 
 
@@ -36,12 +37,13 @@ def test_jumps_growing_alone_resolve_a_cycle_per_doubling(total):
 def test_jumps_held_at_a_level_resolve_a_window_and_a_settling_per_jump(window, settle, jump):
     # b = 0: every jump is the level once growth has reached it (from the
     # level itself here): measurements of ``window`` cycles, ``jump + settle``
-    # cycles apart, and the settling cycles resolved as well
+    # cycles apart, and the settling cycles resolved as well; the last jump
+    # stops short of the end, whose cycle is resolved too
     total = 10_000.0
     measurements = math.ceil(total / (window + jump + settle))
     cycles = _cycles_left(0.0, total, window, settle, jump, (jump, 0.0, 1.0))
     assert measurements * window + (measurements - 1) * settle <= cycles
-    assert cycles <= measurements * (window + settle)
+    assert cycles <= (measurements + 1) * (window + settle)
 
 
 def test_no_jump_at_all_resolves_every_cycle_left():
