@@ -133,7 +133,7 @@ def estimate_run(model, state=None, started=None):
                  per_step=per_step, points=active * max(1, model.slots), active=active,
                  vertices=vertices, load=load, returns=returns)
     if model.cycle_steps:
-        j = _jumping(model, e.stepping - load, started + ANSWER_SECONDS)
+        j = _jumping(model, e.stepping - load, started + ANSWER_SECONDS, per_step)
         e.stepping, e.low, e.high = load + j.seconds, load + j.low, load + j.high
         e.trial_time, e.trial_covered, e.trial_jumps = j.trial_time, j.covered, j.jumps
         e.cycles = j.cycles
@@ -342,18 +342,25 @@ def _forecast(model, state, elapsed, resolved):
     settle = 0 if model.quasi_static else 1      # a dynamic run resolves a cycle after a jump
     position, total = state.step / n_c, model.n_steps / n_c
     window = float(js.window)
-    waiting = 0.0
+    resolved_by = js.resolved_steps / n_c
+    if 0 < state.step - js.cycle_start < js.window * n_c:
+        # stopped inside a measurement: the rule counts it whole from its start
+        position = js.cycle_start / n_c
+    waiting = soonest = 0.0
     if js.jumps == 0:
-        # the measurements the noise bounds need before the first jump
+        # the measurements the noise bounds need before the first jump; the
+        # controller may jump from the second (it needs one before)
         waiting = max(0, FIRST_JUMP_MEASUREMENTS - len(js.history)) * window
+        soonest = max(0, 1 - len(js.history)) * window
     longest = max((j for _, j, _ in js.taken), default=0)
     fast, slow = _trend_range(js.taken, longest)
     cycles = []
     central = _bound_trend(js.taken)
     central = None if central is None else (*central, 1.0)
-    for trend in (central, fast, "none" if slow is None else slow):
-        start = min(position + waiting, total)
-        cycles.append(done + min(waiting, total - position)
+    for trend, wait in ((central, waiting), (fast, soonest),
+                        ("none" if slow is None else slow, waiting)):
+        start = min(position + wait, total)
+        cycles.append(resolved_by + min(wait, total - position)
                       + _cycles_left(start, total, window, settle, float(js.last_jump), trend))
     seconds = [min(resolved, elapsed + per_output * remaining + (c - done) * per_cycle)
                for c in cycles]
@@ -361,11 +368,12 @@ def _forecast(model, state, elapsed, resolved):
                    (cycles[0], min(cycles), max(cycles)))
 
 
-def _jumping(model, resolved, deadline=None):
+def _jumping(model, resolved, deadline=None, per_step=0.0):
     """The :class:`_Jumped` of a cycle-jumping run: the run itself tried for
     :data:`JUMP_TRIAL` s (or to its end; longer, up to
-    :data:`JUMP_TRIAL_LONGEST` s or ``deadline`` (a ``perf_counter`` time)
-    if that is later, while it has seen fewer than :data:`BOUNDED_JUMPS`
+    :data:`JUMP_TRIAL_LONGEST` s, or with a ``deadline`` (a ``perf_counter``
+    time) up to it less the steps it may take between two looks at the
+    clock (``per_step`` s each), while it has seen fewer than :data:`BOUNDED_JUMPS`
     jumps set by a bound other than growth or its range is wider than
     :data:`WIDEST`), the rest simulated at the trial's cost per resolved
     cycle with the controller's rule: the measurements it still needs
@@ -378,7 +386,7 @@ def _jumping(model, resolved, deadline=None):
     output (the writing itself is :func:`_writing`'s). Never more than
     ``resolved``."""
     from .jumps import compile_kernels
-    from .simulate import run
+    from .simulate import PROGRESS_STEPS, run
 
     if model.scene.wear.jump == "implicit":
         compile_kernels()            # as the loop's kernels are, before the timing
@@ -387,7 +395,10 @@ def _jumping(model, resolved, deadline=None):
     budget = min(JUMP_TRIAL, resolved)
     longest = JUMP_TRIAL_LONGEST
     if deadline is not None:
-        longest = max(longest, deadline - start)
+        # the trial sees the clock every PROGRESS_STEPS steps (or output)
+        # at least: it may run that much past its limit (the spur gears'
+        # check answered in 35 s, its steps of 5 ms on a busy machine)
+        longest = max(budget, deadline - start - PROGRESS_STEPS * per_step)
 
     def progress(step, n_steps):
         elapsed = time.perf_counter() - start

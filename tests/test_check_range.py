@@ -99,7 +99,8 @@ def ball():
 
 @pytest.mark.parametrize("bounded", [3, 5, pytest.param(7, marks=pytest.mark.xfail(
     strict=True, reason="a known miss: the trial's bounded jumps (5-10 cycles to cycle 135) "
-    "do not show the growth-held 21, 43, 57 and 115 that follow; 157-213 cycles for 150"))])
+    "do not show the growth-held 21, 43, 57 and 115 that follow: its range starts above the "
+    "run's 150 cycles"))])
 def test_the_range_of_resolved_cycles_holds_the_run_s(ball, bounded):
     """A trial stopped once ``bounded`` jumps were set by a bound other than
     growth (not on the clock: the cycles resolved do not depend on the
