@@ -395,10 +395,11 @@ def _jumping(model, resolved, deadline=None, per_step=0.0):
     budget = min(JUMP_TRIAL, resolved)
     longest = JUMP_TRIAL_LONGEST
     if deadline is not None:
-        # the trial sees the clock every PROGRESS_STEPS steps (or output)
-        # at least: it may run that much past its limit (the spur gears'
-        # check answered in 35 s, its steps of 5 ms on a busy machine)
-        longest = max(budget, deadline - start - PROGRESS_STEPS * per_step)
+        # the trial sees the clock every PROGRESS_STEPS steps, output or
+        # cycle at least: it may run that much past its limit (the spur
+        # gears' check answered in 35 s, its steps of 5 ms on a busy machine)
+        gap = min(PROGRESS_STEPS, model.cycle_steps) * per_step
+        longest = max(budget, deadline - start - gap)
 
     def progress(step, n_steps):
         elapsed = time.perf_counter() - start
