@@ -392,8 +392,8 @@ def _check(scene_path, overrides=()):
     if e.cycles:
         (low, high), (cycles, few, many) = e.range, e.cycles
         print(f"  run time range with cycle jumping {low:.3g}–{high:.3g} s ({high / low:.2g}x), "
-              f"{few:.0f}–{many:.0f} of {model.n_steps / model.cycle_steps:.6g} cycles resolved "
-              f"(estimate {cycles:.0f}): the jumps after the trial from the fastest to the "
+              f"{few:.4g}–{many:.4g} of {model.n_steps / model.cycle_steps:.6g} cycles resolved "
+              f"(estimate {cycles:.4g}): the jumps after the trial from the fastest to the "
               "slowest trend its bounded jumps allow")
     return EXIT_OK
 

@@ -38,9 +38,9 @@ RETURNS = 20
 #: :func:`meshwear.wear._counter_noise`)
 FIRST_JUMP_MEASUREMENTS = 3
 #: wall time (s) from the start of ``meshwear check`` (or of
-#: :func:`estimate_run`) by which the jump trial ends at the latest, when
-#: longer than JUMP_TRIAL_LONGEST: a trial whose range is wider than
-#: WIDEST goes on until then (the answer within 30 s, docs/performance.md:
+#: :func:`estimate_run`) by which the jump trial ends at the latest (in
+#: place of JUMP_TRIAL_LONGEST): a trial whose range is wider than WIDEST
+#: goes on until then (the answer within 30 s, docs/performance.md:
 #: the interpreter's start and imports come before, and the trial looks at
 #: the clock only every output or 2 000 steps; at 24 s the CAD part's check
 #: answered in 30.4 s on a busy machine)
@@ -240,9 +240,9 @@ def _trend_range(taken, longest):
     or more) give ``b`` and the level by least squares of ``log J`` on
     ``log p``, each within its :data:`CONFIDENCE` interval (Student's t of
     the scatter of noise-held jumps about their trend, n - 2 degrees of
-    freedom: three jumps on a line tell little of its slope). With one or two: from growth alone
-    to jumps held at their median. With none: from growth alone to jumps
-    held at the longest the trial took."""
+    freedom: three jumps on a line tell little of its slope). With one or
+    two: from growth alone to jumps held at their median. With none: from
+    growth alone to jumps held at the longest the trial took."""
     from scipy.stats import t as student_t
 
     bounded = [(p, j) for p, j, which in taken if which not in ("growth", "end")]
