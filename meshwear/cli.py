@@ -324,13 +324,6 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=
     return EXIT_OK
 
 
-#: the ratio of two meshes' edge lengths where they touch from which
-#: ``check`` gives notice (docs/model.md, "Worn counter-surfaces": a 2:1
-#: pad on a flat wore 84 % stripes; a counter coarser than twice the body's
-#: spacing does not spread its wear)
-SPACING_RATIO = 2.0
-
-
 def _check(scene_path, overrides=()):
     import numpy as np
 
@@ -374,7 +367,9 @@ def _check(scene_path, overrides=()):
         print(f"  cycle jumping: {model.cycle_steps} steps per cycle, {cycles:.6g} cycles, "
               f"{scene.wear.jump} jumps, tolerance {scene.wear.tolerance:g}; outputs inside "
               "jumps are filled from them")
-    for line in _spacing_notices(model, state):
+    from .remesh import spacing_notices
+
+    for line in spacing_notices(model, state):
         print(f"  notice: {line}")
     from .estimate import estimate_run
 
@@ -396,38 +391,6 @@ def _check(scene_path, overrides=()):
               f"(estimate {cycles:.4g}): the jumps after the trial from the fastest to the "
               "slowest trend its bounded jumps allow")
     return EXIT_OK
-
-
-def _spacing_notices(model, state):
-    """One line per body and mesh surface whose edge lengths where they
-    touch differ by :data:`SPACING_RATIO` or more."""
-    from .remesh import spacing_ratio
-    from .surfaces import quaternion_matrix
-
-    lines = []
-    for body, s in zip(model.bodies, state.bodies):
-        world = s.pose[0:3] + s.vertices @ quaternion_matrix(s.pose[3:7]).T
-        for surface in model.surfaces.slots:
-            faces = getattr(surface, "faces", None)
-            if faces is None or not hasattr(surface, "world_vertices"):
-                continue                 # an analytic surface: no spacing of its own
-            spacing = spacing_ratio(world, body.faces, s.active,
-                                    surface.world_vertices(surface.vertices, 0.0), faces)
-            if spacing is None:
-                continue
-            h_body, h_counter = spacing
-            ratio = max(h_body, h_counter) / min(h_body, h_counter)
-            if ratio >= SPACING_RATIO:
-                finer = h_counter < h_body
-                why = "" if not getattr(surface, "worn", False) else (
-                    "; a worn counter finer than the body wears in tracks a body vertex apart"
-                    if finer else "; a worn counter coarser than the body smooths its wear "
-                    "over its own spacing") + " (docs/model.md, \"Worn counter-surfaces\")"
-                lines.append(
-                    f"body {body.name!r} ({h_body * 1e6:.3g} µm edges where it touches) and "
-                    f"mesh surface {surface.name!r} ({h_counter * 1e6:.3g} µm there) differ "
-                    f"{ratio:.2g}:1 in resolution{why}")
-    return lines
 
 
 def _slot_configs(scene, model):
