@@ -329,6 +329,7 @@ def _check(scene_path, overrides=()):
 
     from .remesh import describe_refinement
 
+    started = time.perf_counter()        # the estimate's trial answers within 30 s of this
     scene, model, limit = _prepare(scene_path, overrides)
     print(f"scene {scene.source}: ok (format 1, mode {scene.run.mode})")
     for key, value in overrides:
@@ -374,9 +375,13 @@ def _check(scene_path, overrides=()):
         print(f"  cycle jumping: {model.cycle_steps} steps per cycle, {cycles:.6g} cycles, "
               f"{scene.wear.jump} jumps, tolerance {scene.wear.tolerance:g}; outputs inside "
               "jumps are filled from them")
+    from .remesh import spacing_notices
+
+    for line in spacing_notices(model, state):
+        print(f"  notice: {line}")
     from .estimate import estimate_run
 
-    e = estimate_run(model, state)
+    e = estimate_run(model, state, started)
     full = "" if not model.cycle_steps else (
         "with cycle jumping " if e.trial_covered >= model.n_steps else
         f"with cycle jumps growing as in a {e.trial_time:.2g} s trial " if e.trial_jumps else
@@ -387,6 +392,12 @@ def _check(scene_path, overrides=()):
           f"{e.active} of {e.vertices} vertices within reach of a surface), "
           f"writing {e.writing:.3g} s ({len(model.frame_steps)} frames, "
           f"{len(model.sample_steps)} history rows)")
+    if e.cycles:
+        (low, high), (cycles, few, many) = e.range, e.cycles
+        print(f"  run time range with cycle jumping {low:.3g}–{high:.3g} s ({high / low:.2g}x), "
+              f"{few:.4g}–{many:.4g} of {model.n_steps / model.cycle_steps:.6g} cycles resolved "
+              f"(estimate {cycles:.4g}): the jumps after the trial from the fastest to the "
+              "slowest trend its bounded jumps allow")
     return EXIT_OK
 
 

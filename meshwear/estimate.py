@@ -6,6 +6,7 @@ The estimate is of the wall time ``meshwear run`` reports (``done in``,
 ``summary.json`` ``wall_time``): from the model built to the outputs closed.
 """
 
+import math
 import tempfile
 import time
 from dataclasses import dataclass
@@ -36,6 +37,19 @@ RETURNS = 20
 #: jump through (a vertex's scatter is fitted over three:
 #: :func:`meshwear.wear._counter_noise`)
 FIRST_JUMP_MEASUREMENTS = 3
+#: wall time (s) from the start of ``meshwear check`` (or of
+#: :func:`estimate_run`) by which the jump trial ends at the latest (in
+#: place of JUMP_TRIAL_LONGEST): a trial whose range is wider than WIDEST
+#: goes on until then (the answer within 30 s, docs/performance.md:
+#: the interpreter's start and imports come before, and the trial looks at
+#: the clock only every output or 2 000 steps; at 24 s the CAD part's check
+#: answered in 30.4 s on a busy machine)
+ANSWER_SECONDS = 20.0
+#: the range (high / low) a jump trial with BOUNDED_JUMPS stops at
+WIDEST = 3.0
+#: the confidence the range's trends of bounded jumps are taken at, either
+#: side (Student's t of the trial's scatter: :func:`_trend_range`)
+CONFIDENCE = 0.95
 
 
 @dataclass
@@ -57,20 +71,34 @@ class Estimate:
     trial_jumps: int = 0
     load: float = 0.0
     returns: float = 0.0
+    low: float = 0.0
+    high: float = 0.0
+    cycles: tuple = ()
 
     @property
     def total(self):
         return self.stepping + self.writing
+
+    @property
+    def range(self):
+        """``(low, high)`` s of the run's wall time: for cycle jumping, the
+        jumps after the trial following the slowest and fastest trends its
+        bounded jumps allow (:func:`_trend_range`); else the estimate."""
+        if not self.cycles:
+            return self.total, self.total
+        return self.low + self.writing, self.high + self.writing
 
 
 class _Budget(Exception):
     pass
 
 
-def estimate_run(model, state=None):
+def estimate_run(model, state=None, started=None):
     """The :class:`Estimate` of ``model``'s run from ``state``, a fresh one
     (made here if None; it is stepped); nothing written but temporary
-    files."""
+    files. ``started``: the ``time.perf_counter()`` the answer's
+    :data:`ANSWER_SECONDS` count from (default now)."""
+    started = time.perf_counter() if started is None else started
     state = initial_state(model) if state is None else state
     # compile (or load the cached) kernels, as the run does, and take the
     # steps in which the dynamics try their active sets (a mechanism's first
@@ -105,9 +133,10 @@ def estimate_run(model, state=None):
                  per_step=per_step, points=active * max(1, model.slots), active=active,
                  vertices=vertices, load=load, returns=returns)
     if model.cycle_steps:
-        e.stepping, e.trial_time, e.trial_covered, e.trial_jumps = _jumping(
-            model, e.stepping - load)
-        e.stepping += load
+        j = _jumping(model, e.stepping - load, started + ANSWER_SECONDS, per_step)
+        e.stepping, e.low, e.high = load + j.seconds, load + j.low, load + j.high
+        e.trial_time, e.trial_covered, e.trial_jumps = j.trial_time, j.covered, j.jumps
+        e.cycles = j.cycles
     return e
 
 
@@ -193,56 +222,118 @@ def _bound_trend(taken):
     return float(np.exp(np.median(j - b * p))), b
 
 
+def _trend_range(taken, longest):
+    """``(fast, slow)``: the trends ``(a, b, c)``, jumps ``J = a (p / c)^b``
+    at cycle ``p``, that bound the run's jumps after a trial that took
+    ``taken`` (``longest``: its longest jump); ``fast`` None for jumps
+    growing by :data:`meshwear.wear.GROWTH` alone, ``slow`` None for no jump
+    at all.
+
+    What a bound other than growth allows moves with the depth worn and the
+    error it reads, as ``p^b``: b = 1 for an error allowance in proportion
+    to the depth and a steady per-cycle error; less where the error grows
+    with the scar (b = 0: drift or noise growing as the depth does; below:
+    faster), more where it falls (running-in settles, a wider window
+    averages the noise: the fretting ball's noise-held jumps went from
+    5 to 45 cycles while its cycles went from 72 to 457). So ``b`` is not
+    bounded by the physics, only measured: the trial's bounded jumps (three
+    or more) give ``b`` and the level by least squares of ``log J`` on
+    ``log p``, each within its :data:`CONFIDENCE` interval (Student's t of
+    the scatter of noise-held jumps about their trend, n - 2 degrees of
+    freedom: three jumps on a line tell little of its slope). With one or
+    two: from growth alone to jumps held at their median. With none: from
+    growth alone to jumps held at the longest the trial took."""
+    from scipy.stats import t as student_t
+
+    bounded = [(p, j) for p, j, which in taken if which not in ("growth", "end")]
+    if not bounded:
+        return None, ((float(longest), 0.0, 1.0) if longest >= 1 else None)
+    x, y = np.log(np.array(bounded, dtype=float).T)
+    sxx = float(((x - x.mean()) ** 2).sum())
+    if len(x) < 3 or sxx <= 0.0:
+        return None, (float(np.exp(np.median(y))), 0.0, 1.0)
+    centre, level = float(x.mean()), float(y.mean())
+    b = float(((x - centre) * (y - level)).sum()) / sxx
+    scatter = float(np.sqrt(((y - level - b * (x - centre)) ** 2).sum() / (len(x) - 2)))
+    t = float(student_t.ppf(0.5 + 0.5 * CONFIDENCE, len(x) - 2))
+    spread = t * scatter / np.sqrt(len(x))           # of the level at the centre
+    error = t * scatter / np.sqrt(sxx)               # of the slope
+    return ((float(np.exp(level + spread)), b + error, float(np.exp(centre))),
+            (float(np.exp(level - spread)), b - error, float(np.exp(centre))))
+
+
+def _jump_at(trend, p):
+    """``trend``'s jump (cycles) at cycle ``p``: ``a (p / c)^b``."""
+    a, b, c = trend
+    return a * math.exp(min(700.0, b * math.log(max(p, 1e-300) / c)))
+
+
+def _cycles_left(position, total, window, settle, jump, trend):
+    """Cycles the run resolves from cycle ``position`` to ``total`` by the
+    controller's rule: a measurement of ``window`` cycles, then a jump
+    (``GROWTH J + 1`` from the last ``jump``, up to ``trend``'s ``a p^b``,
+    at least one cycle; None: growth alone, "none": no jump) that leaves
+    the run's last cycle resolved, and ``settle`` cycles after it."""
+    from .wear import GROWTH
+
+    cycles = 0.0
+    if trend == "none":
+        return max(0.0, total - position)
+    while position < total:
+        cycles += min(window, total - position)     # (the run's last cycle may be cut short)
+        position += window
+        jump = GROWTH * jump + 1.0
+        if trend is not None:
+            jump = max(1.0, min(jump, _jump_at(trend, position)))
+        # the run ends with a resolved cycle (the bound "end")
+        taken = min(jump, math.ceil(total - position) - 1.0)
+        if taken >= 1.0:
+            position += taken + settle
+            cycles += settle
+    return cycles
+
+
+@dataclass
+class _Jumped:
+    """What :func:`_jumping` tells: seconds of stepping (central, low,
+    high), the trial, and the resolved cycles (central, low, high)."""
+
+    seconds: float
+    low: float
+    high: float
+    trial_time: float
+    covered: int
+    jumps: int
+    cycles: tuple
+
+
+def _resolved(js, step, n_c):
+    """Cycles a trial that stopped at ``step`` resolved (``js``: its
+    :class:`meshwear.wear.JumpState`): the steps of the measurement it
+    stopped in count too (stopped past it, at a jump: none)."""
+    partial = step - js.cycle_start
+    return (js.resolved_steps + (partial if 0 < partial < js.window * n_c else 0)) / n_c
+
+
 def _per_cycle(elapsed, js, step, n_c):
     """Seconds of a resolved cycle, its jump's work included, from a trial
     of ``elapsed`` s that stopped at ``step`` (``js``: its
     :class:`meshwear.wear.JumpState`): the steps of the cycle it stopped in
     count too, their time being in the trial's (not counting them made the
     gear pair's estimate 25 % high: a trial of 3 revolutions read as 2)."""
-    steps = js.resolved_steps + max(0, step - js.cycle_start)
-    return (elapsed - js.fill_seconds) / max(steps / n_c, 1.0)
+    return (elapsed - js.fill_seconds) / max(_resolved(js, step, n_c), 1.0)
 
 
-def _jumping(model, resolved):
-    """``(seconds, trial seconds, steps covered by the trial, jumps in the
-    trial)`` of a cycle-jumping run: the run itself tried for
-    :data:`JUMP_TRIAL` s (or to its end; longer while it has seen fewer than
-    :data:`BOUNDED_JUMPS` jumps set by a bound other than growth), the rest
-    simulated at the trial's cost per resolved cycle with the controller's
-    rule: the measurements it still needs before a first jump
-    (:data:`FIRST_JUMP_MEASUREMENTS`), then per jump a cycle to settle (the
-    dynamic mode) and a measurement of the trial's window of cycles, jumps
-    growing (``GROWTH J + 1``) up to the trend of the other bounds in the
-    trial (:func:`_bound_trend`); and the remaining outputs filled from jumps
-    at the trial's cost per filled output (the writing itself is
-    :func:`_writing`'s). Never more than ``resolved``."""
-    from .jumps import compile_kernels
-    from .simulate import run
-    from .wear import GROWTH
-
-    if model.scene.wear.jump == "implicit":
-        compile_kernels()            # as the loop's kernels are, before the timing
-    state = initial_state(model)
-    start = time.perf_counter()
-    budget = min(JUMP_TRIAL, resolved)
-
-    def progress(step, n_steps):
-        elapsed = time.perf_counter() - start
-        js = state.jump
-        bounded = 0 if js is None else sum(w not in ("growth", "end") for _, _, w in js.taken)
-        if elapsed > budget and (bounded >= BOUNDED_JUMPS or elapsed > JUMP_TRIAL_LONGEST):
-            raise _Budget
-
-    try:
-        run(model, state, progress=progress)
-    except _Budget:
-        pass
-    elapsed = time.perf_counter() - start
-    if state.step >= model.n_steps:
-        return (min(resolved, elapsed), elapsed, state.step,
-                state.jump.jumps if state.jump else 0)
-    n_c = model.cycle_steps
+def _forecast(model, state, elapsed, resolved):
+    """The :class:`_Jumped` of a run whose trial took ``elapsed`` s to
+    ``state`` (see :func:`_jumping`)."""
     js = state.jump
+    n_c = model.cycle_steps
+    done = _resolved(js, state.step, n_c)
+    if state.step >= model.n_steps:
+        seconds = min(resolved, elapsed)
+        return _Jumped(seconds, seconds, seconds, elapsed, state.step, js.jumps,
+                       (done, done, done))
     # outputs inside a jump are filled from it: their cost beyond writing
     # them goes with the outputs left, not with the cycles
     per_output = js.fill_seconds / max(js.filled_outputs, 1)
@@ -250,22 +341,81 @@ def _jumping(model, resolved):
     per_cycle = _per_cycle(elapsed, js, state.step, n_c)
     settle = 0 if model.quasi_static else 1      # a dynamic run resolves a cycle after a jump
     position, total = state.step / n_c, model.n_steps / n_c
-    bound = _bound_trend(js.taken)
-    jump = float(js.last_jump)
     window = float(js.window)
-    seconds = elapsed + per_output * remaining
+    resolved_by = js.resolved_steps / n_c
+    if 0 < state.step - js.cycle_start < js.window * n_c:
+        # stopped inside a measurement: the rule counts it whole from its start
+        position = js.cycle_start / n_c
+    waiting = soonest = 0.0
     if js.jumps == 0:
-        # the measurements the noise bounds need before the first jump
+        # the measurements the noise bounds need before the first jump; the
+        # controller may jump from the second (it needs one before)
         waiting = max(0, FIRST_JUMP_MEASUREMENTS - len(js.history)) * window
-        position += waiting
-        seconds += waiting * per_cycle
-    while position < total and seconds < resolved:
-        position += window
-        seconds += window * per_cycle
-        jump = GROWTH * jump + 1.0
-        if bound is not None:
-            jump = max(1.0, min(jump, bound[0] * position ** bound[1]))
-        if position < total:
-            position += jump + settle
-            seconds += settle * per_cycle
-    return min(resolved, seconds), elapsed, state.step, js.jumps
+        soonest = max(0, 1 - len(js.history)) * window
+    longest = max((j for _, j, _ in js.taken), default=0)
+    fast, slow = _trend_range(js.taken, longest)
+    cycles = []
+    central = _bound_trend(js.taken)
+    central = None if central is None else (*central, 1.0)
+    for trend, wait in ((central, waiting), (fast, soonest),
+                        ("none" if slow is None else slow, waiting)):
+        start = min(position + wait, total)
+        cycles.append(resolved_by + min(wait, total - position)
+                      + _cycles_left(start, total, window, settle, float(js.last_jump), trend))
+    seconds = [min(resolved, elapsed + per_output * remaining + (c - done) * per_cycle)
+               for c in cycles]
+    return _Jumped(seconds[0], min(seconds), max(seconds), elapsed, state.step, js.jumps,
+                   (cycles[0], min(cycles), max(cycles)))
+
+
+def _jumping(model, resolved, deadline=None, per_step=0.0):
+    """The :class:`_Jumped` of a cycle-jumping run: the run itself tried for
+    :data:`JUMP_TRIAL` s (or to its end; longer, up to
+    :data:`JUMP_TRIAL_LONGEST` s, or with a ``deadline`` (a ``perf_counter``
+    time) up to it less the steps it may take between two looks at the
+    clock (``per_step`` s each), while it has seen fewer than :data:`BOUNDED_JUMPS`
+    jumps set by a bound other than growth or its range is wider than
+    :data:`WIDEST`), the rest simulated at the trial's cost per resolved
+    cycle with the controller's rule: the measurements it still needs
+    before a first jump (:data:`FIRST_JUMP_MEASUREMENTS`), then per jump a
+    cycle to settle (the dynamic mode) and a measurement of the trial's
+    window of cycles, jumps growing (``GROWTH J + 1``) up to the trend of
+    the other bounds in the trial (:func:`_bound_trend`; for the range, the
+    fastest and slowest trends they allow: :func:`_trend_range`); and the
+    remaining outputs filled from jumps at the trial's cost per filled
+    output (the writing itself is :func:`_writing`'s). Never more than
+    ``resolved``."""
+    from .jumps import compile_kernels
+    from .simulate import PROGRESS_STEPS, run
+
+    if model.scene.wear.jump == "implicit":
+        compile_kernels()            # as the loop's kernels are, before the timing
+    state = initial_state(model)
+    start = time.perf_counter()
+    budget = min(JUMP_TRIAL, resolved)
+    longest = JUMP_TRIAL_LONGEST
+    if deadline is not None:
+        # the trial sees the clock every PROGRESS_STEPS steps, output or
+        # cycle at least: it may run that much past its limit (the spur
+        # gears' check answered in 35 s, its steps of 5 ms on a busy machine)
+        gap = min(PROGRESS_STEPS, model.cycle_steps) * per_step
+        longest = max(budget, deadline - start - gap)
+
+    def progress(step, n_steps):
+        elapsed = time.perf_counter() - start
+        if elapsed <= budget:
+            return
+        if elapsed > longest:
+            raise _Budget
+        js = state.jump
+        bounded = 0 if js is None else sum(w not in ("growth", "end") for _, _, w in js.taken)
+        if bounded >= BOUNDED_JUMPS:
+            j = _forecast(model, state, elapsed, resolved)
+            if j.high <= WIDEST * j.low:
+                raise _Budget
+
+    try:
+        run(model, state, progress=progress)
+    except _Budget:
+        pass
+    return _forecast(model, state, time.perf_counter() - start, resolved)

@@ -1,7 +1,10 @@
-"""Conforming refinement of triangle meshes (longest-edge bisection).
+"""Conforming refinement of triangle meshes (longest-edge bisection), and
+the comparison of two parts' spacings where they touch (``meshwear check``'s
+notice: :func:`spacing_notices`).
 
 Plain arrays in and out, as in :mod:`meshwear.geometry` (which this module
-builds on and which does not import it).
+builds on and which does not import it); :func:`spacing_notices` alone
+reads a model.
 """
 
 import numpy as np
@@ -390,3 +393,74 @@ def describe_refinement(info):
     return (text + f"; facet sag {info['sag']:.2g} m where refined "
             f"({info['sag'] / info['resolution']:.2g} of the resolution), "
             f"{info['sag_elsewhere']:.2g} m elsewhere")
+
+
+def spacing_near(vertices, faces, low, high):
+    """Median edge length (m) of the edges of ``faces`` with both ends inside
+    the box ``low``..``high`` (3,) of ``vertices`` (n, 3), None if none: a
+    mesh's spacing where another touches it (:func:`contact_spacings`)."""
+    inside = np.all((vertices >= low) & (vertices <= high), axis=1)
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    edges = edges[inside[edges].all(axis=1)]
+    if not len(edges):
+        return None
+    return float(np.median(np.linalg.norm(vertices[edges[:, 0]] - vertices[edges[:, 1]],
+                                          axis=1)))
+
+
+def spacing_ratio(body_vertices, body_faces, active, counter_vertices, counter_faces):
+    """``(h_body, h_counter)``, the median edge lengths (m) of a body's
+    contact (its ``active`` vertices, world frame) and of a counter mesh
+    under it (world frame: its vertices within the body's contact box,
+    widened by two of the body's edges), or None where either has no edge
+    there. A worn counter much finer or coarser than the body there wears
+    in tracks or smooths the body's wear (docs/model.md, "Worn
+    counter-surfaces")."""
+    if not len(active):
+        return None
+    points = body_vertices[active]
+    low, high = points.min(axis=0), points.max(axis=0)
+    h_body = spacing_near(body_vertices, body_faces, low, high)
+    if h_body is None:
+        return None
+    h_counter = spacing_near(counter_vertices, counter_faces, low - 2 * h_body,
+                             high + 2 * h_body)
+    return None if h_counter is None else (h_body, h_counter)
+
+
+#: the ratio of two meshes' edge lengths where they touch from which
+#: ``check`` gives notice (docs/model.md, "Worn counter-surfaces": a 2:1
+#: pad on a flat wore 84 % stripes; a counter coarser than twice the body's
+#: spacing does not spread its wear)
+SPACING_RATIO = 2.0
+
+
+def spacing_notices(model, state):
+    """One line per body and mesh surface whose edge lengths where they
+    touch differ by :data:`SPACING_RATIO` or more."""
+    from .surfaces import quaternion_matrix
+
+    lines = []
+    for body, s in zip(model.bodies, state.bodies):
+        world = s.pose[0:3] + s.vertices @ quaternion_matrix(s.pose[3:7]).T
+        for surface in model.surfaces.slots:
+            faces = getattr(surface, "faces", None)
+            if faces is None or not hasattr(surface, "world_vertices"):
+                continue                 # an analytic surface: no spacing of its own
+            spacing = spacing_ratio(world, body.faces, s.active,
+                                    surface.world_vertices(surface.vertices, 0.0), faces)
+            if spacing is None:
+                continue
+            h_body, h_counter = spacing
+            ratio = max(h_body, h_counter) / min(h_body, h_counter)
+            if ratio >= SPACING_RATIO:
+                finer = h_counter < h_body
+                why = "" if not getattr(surface, "worn", False) else (
+                    "; a worn counter finer than the body wears in tracks a body vertex apart"
+                    if finer else "; a worn counter coarser than the body smooths its wear "
+                    "over its own spacing") + " (docs/model.md, \"Worn counter-surfaces\")"
+                lines.append(
+                    f"body {body.name!r} ({h_body * 1e6:.3g} µm edges where it touches) and "
+                    f"mesh surface {surface.name!r} ({h_counter * 1e6:.3g} µm there) differ "
+                    f"{ratio:.2g}:1 in resolution{why}")
+    return lines
