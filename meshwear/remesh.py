@@ -438,11 +438,13 @@ SPACING_RATIO = 2.0
 def spacing_notices(model, state):
     """One line per body and mesh surface whose edge lengths where they
     touch differ by :data:`SPACING_RATIO` or more."""
-    from .surfaces import quaternion_matrix
+    # (surfaces import this module: the rotation from the kernels)
+    from .kernels.contact import rotation_entries
 
     lines = []
     for body, s in zip(model.bodies, state.bodies):
-        world = s.pose[0:3] + s.vertices @ quaternion_matrix(s.pose[3:7]).T
+        R = np.array(rotation_entries(np.asarray(s.pose[3:7], float))).reshape(3, 3)
+        world = s.pose[0:3] + s.vertices @ R.T
         for surface in model.surfaces.slots:
             faces = getattr(surface, "faces", None)
             if faces is None or not hasattr(surface, "world_vertices"):
