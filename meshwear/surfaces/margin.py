@@ -72,12 +72,12 @@ def contact_margin(scene, config, vertices, area_vectors, pose, motion, surface_
     c = scene.contact
     # a quasi-static guided body (meshwear.motion.BalancedMotion) carries a load
     load = abs(float(motion.carried)) if motion.kind == BALANCED else 0.0
+    if load <= 0.0 or motion.turn_rate != 0.0 or c.model == "half-space" or not surface_set.slots:
+        return fallback
     # a turning mesh's shape invariance is judged against the margin
     # (MeshSurface.settle_invariance): a ring faceted by more than a quarter
     # of a contact-sized margin would be followed as it turns, at a cost
-    turning = any(s.motion.rate != 0.0 for s in surface_set.meshes)
-    if (load <= 0.0 or motion.turn_rate != 0.0 or turning or c.model == "half-space"
-            or not surface_set.slots):
+    if any(getattr(s.motion, "rate", 0.0) != 0.0 for s in surface_set.meshes):
         return fallback
     gap, area = _gaps(vertices, area_vectors, pose, surface_set, 2.0 * size)
     touching = np.isfinite(gap) & (area > 0.0)
