@@ -409,22 +409,19 @@ def build_model(scene):
         vertex_planes = surfaces.initial_planes(surface_set, b, b.initial_pose, 2.0 * b.radius)[0]
         # where it was placed, before a quasi-static body is settled on its load
         _refuse_deep_start(scene, j, b, config, surface_set, vertex_planes)
-        if isinstance(b.motion, BalancedMotion):
-            if not b.motion.settle(b.initial_pose, b.reference_vertices, b.area_vectors,
-                                   plane_array, vertex_planes,
-                                   all_vertices(len(b.reference_vertices)), law):
-                raise SceneError(scene.source, f"body[{j}].path.free_axis",
-                                 f"no surface can carry the load of body {config.name!r} along "
-                                 f"{list(config.path.free_axis)} (the load pulls it off every "
-                                 "surface, or no surface faces it along that axis)")
-        if isinstance(b.motion, TurningMotion):
-            if not b.motion.settle(b.initial_pose, b.reference_vertices, b.area_vectors,
-                                   plane_array, vertex_planes,
-                                   all_vertices(len(b.reference_vertices)), law):
+        if (isinstance(b.motion, (BalancedMotion, TurningMotion))
+                and not b.motion.settle(b.initial_pose, b.reference_vertices, b.area_vectors,
+                                        plane_array, vertex_planes,
+                                        all_vertices(len(b.reference_vertices)), law)):
+            if isinstance(b.motion, TurningMotion):
                 raise SceneError(scene.source, f"body[{j}].path.rotation.torque",
                                  f"no contact can carry the torque of body {config.name!r} "
                                  f"about {list(config.path.rotation.axis)} (no surface it "
                                  "touches, turning that way, has a lever about the axis)")
+            raise SceneError(scene.source, f"body[{j}].path.free_axis",
+                             f"no surface can carry the load of body {config.name!r} along "
+                             f"{list(config.path.free_axis)} (the load pulls it off every "
+                             "surface, or no surface faces it along that axis)")
     # a turning mesh is static in shape if it is a surface of revolution
     # about its axis, against the smallest active-set margin
     margin = min(surfaces.margin_of(scene, b) for b in bodies)
