@@ -5,9 +5,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from meshwear.model import build_model, check_time_step, initial_state
+from meshwear.model.build import build_model, check_time_step, initial_state
 from meshwear.output.recorder import RunRecorder, summary
-from meshwear.simulate import run
+from meshwear.step.simulate import run
 
 
 def timed_run(scene):

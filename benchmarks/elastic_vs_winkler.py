@@ -31,10 +31,10 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import write_measured  # noqa: E402
 
-from meshwear import stepper  # noqa: E402
-from meshwear.halfspace import contact_modulus  # noqa: E402
-from meshwear.model import build_model, initial_state  # noqa: E402
-from meshwear.scene import parse_scene  # noqa: E402
+from meshwear.step import stepper  # noqa: E402
+from meshwear.contact.halfspace import contact_modulus  # noqa: E402
+from meshwear.model.build import build_model, initial_state  # noqa: E402
+from meshwear.scene.format import parse_scene  # noqa: E402
 
 E, NU, R, LOAD, MU = 210e9, 0.3, 0.005, 10.0, 0.5
 E_STAR = contact_modulus((E, E), (NU, NU))

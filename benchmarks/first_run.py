@@ -40,7 +40,7 @@ def overrides(path):
     """``--set`` pairs that shorten the scene at ``path`` to :data:`STEPS`
     steps (or :data:`CYCLES` cycles), with two frames and a few rows."""
     import meshwear
-    from meshwear.model import build_model
+    from meshwear.model.build import build_model
 
     scene = meshwear.load(ROOT / path)
     model = build_model(scene)

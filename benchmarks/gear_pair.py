@@ -30,7 +30,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from common import timed_run, write_measured  # noqa: E402
-from meshwear.scene import load_scene  # noqa: E402
+from meshwear.scene.format import load_scene  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "gear_pair.toml"
@@ -115,7 +115,7 @@ def read_run(scene, out):
     """The model of ``scene``, each gear's wear depth in the last frame of a
     finished run in folder ``out``, each one's (worn volume, friction work)
     and the run's summary.json."""
-    from meshwear.model import build_model
+    from meshwear.model.build import build_model
     from meshwear.output.export import read_frame, series_frames
 
     result = json.loads((out / "summary.json").read_text())

@@ -41,10 +41,10 @@ import numpy as np  # noqa: E402
 from common import write_measured  # noqa: E402
 from gear_pair import ALPHA, MODULE, PITCH, TEETH  # noqa: E402
 from meshwear import cli  # noqa: E402
-from meshwear.model import build_model, initial_state  # noqa: E402
+from meshwear.model.build import build_model, initial_state  # noqa: E402
 from meshwear.output.export import read_frame, series_frames  # noqa: E402
-from meshwear.scene import load_scene  # noqa: E402
-from meshwear.simulate import run  # noqa: E402
+from meshwear.scene.format import load_scene  # noqa: E402
+from meshwear.step.simulate import run  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "mechanisms" / "gear_pair_torque.toml"

@@ -36,9 +36,9 @@ from common import write_measured  # noqa: E402
 from gear_pair import ALPHA, PITCH, TEETH  # noqa: E402
 from gear_pair_torque import flank_profile, last_depths, tooth_and_side  # noqa: E402
 from meshwear import cli  # noqa: E402
-from meshwear.model import build_model, initial_state  # noqa: E402
-from meshwear.scene import load_scene  # noqa: E402
-from meshwear.simulate import run  # noqa: E402
+from meshwear.model.build import build_model, initial_state  # noqa: E402
+from meshwear.scene.format import load_scene  # noqa: E402
+from meshwear.step.simulate import run  # noqa: E402
 from meshwear.surfaces import quaternion_matrix  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -38,7 +38,7 @@ import time
 import numpy as np
 from scipy import fft
 
-from meshwear.halfspace import contact_modulus, make_grid, solve, solve_shear
+from meshwear.contact.halfspace import contact_modulus, make_grid, solve, solve_shear
 
 try:
     import tamaas

@@ -23,10 +23,10 @@ import json
 import time
 from pathlib import Path
 
-from meshwear import wear
-from meshwear.model import build_model, initial_state
-from meshwear.scene import load_scene
-from meshwear.simulate import run
+from meshwear.longrun import wear
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import load_scene
+from meshwear.step.simulate import run
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "cylinder_on_flat_fretting.toml"

@@ -28,11 +28,11 @@ import numpy as np
 from numba import njit
 
 from meshwear.kernels import loop
-from meshwear.model import build_model, initial_state
-from meshwear.scene import load_scene
-from meshwear.simulate import run
-from meshwear import stepper
-from meshwear.stepper import _body_arrays, _motion_arrays
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import load_scene
+from meshwear.step.simulate import run
+from meshwear.step import stepper
+from meshwear.step.stepper import _body_arrays, _motion_arrays
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "mechanisms" / "slider_crank.toml"

@@ -22,9 +22,9 @@ import json
 import time
 from pathlib import Path
 
-from meshwear import stepper
-from meshwear.model import build_model, initial_state
-from meshwear.scene import load_scene
+from meshwear.step import stepper
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import load_scene
 from meshwear.surfaces import active
 
 ROOT = Path(__file__).resolve().parents[1]

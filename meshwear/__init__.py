@@ -24,9 +24,13 @@ if _cache is not None:
     if "numba" in _sys.modules:              # numba read its settings already
         _sys.modules["numba"].config.CACHE_DIR = _cache
 
+from ._moved import install as _install_moved  # noqa: E402  old module paths, deprecated
+
+_install_moved()
+
 #: names of the public interface, imported on first use (numba loads then)
 _API = {"load": "api", "run": "api", "Result": "api", "Part": "api", "Scene": "scene",
-        "SceneError": "scene", "NumericalError": "simulate"}
+        "SceneError": "scene", "NumericalError": "step.simulate"}
 
 __all__ = ["__version__", *_API]
 

@@ -22,8 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .remesh import available_memory
-from .scene import Scene, SceneError, load_scene
+from .geometry.remesh import available_memory
+from .scene.format import Scene, SceneError, load_scene
 
 
 def load(path, values=None):
@@ -47,7 +47,7 @@ def load(path, values=None):
         One line naming the file and the key.
     """
     pairs = list(values.items()) if isinstance(values, dict) else list(values or ())
-    from .scene import _plain
+    from .scene.format import _plain
 
     return load_scene(path, [(k, _plain(v)) for k, v in pairs])
 
@@ -159,10 +159,10 @@ def run(scene, *, out=None, progress=None, vertex_history=False, check_dt=True):
     meshwear.simulate.NumericalError
         The run became numerically invalid (the files written so far stay valid).
     """
-    from .model import build_model, check_time_step, initial_state
+    from .model.build import build_model, check_time_step, initial_state
     from .output.folder import FolderBusy
     from .output.recorder import RunRecorder, summary
-    from .simulate import NumericalError, run as run_model
+    from .step.simulate import NumericalError, run as run_model
 
     if not isinstance(scene, Scene):
         scene = load_scene(scene)

@@ -140,10 +140,10 @@ def exit_path(command):
     and the model built is the scene's fault (2), one in a run the run's (3)."""
     import warnings
 
-    from .geometry import MeshError
+    from .geometry.meshes import MeshError
     from .output.export import ExportError
-    from .scene import SceneError
-    from .simulate import NumericalError
+    from .scene.format import SceneError
+    from .step.simulate import NumericalError
 
     global _notices
     outer, _notices = _notices, _Notices()
@@ -222,14 +222,14 @@ def _set_option(parser):
 
 
 def _overrides(texts):
-    from .scene import parse_override
+    from .scene.format import parse_override
 
     return tuple(parse_override(text) for text in texts)
 
 
 def _prepare(scene_path, overrides=()):
-    from .model import build_model, check_time_step
-    from .scene import load_scene
+    from .model.build import build_model, check_time_step
+    from .scene.format import load_scene
 
     scene = load_scene(scene_path, overrides)
     model = build_model(scene)
@@ -239,11 +239,11 @@ def _prepare(scene_path, overrides=()):
 
 
 def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=()):
-    from . import checkpoint
-    from .model import initial_state
+    from .longrun import checkpoint
+    from .model.build import initial_state
     from .output.folder import FolderBusy
     from .output.recorder import RunRecorder, summary
-    from .simulate import NumericalError, run
+    from .step.simulate import NumericalError, run
 
     scene, model, _ = _prepare(scene_path, overrides)
     out_dir = Path(out) if out else Path("out") / Path(scene_path).stem
@@ -327,7 +327,7 @@ def _run(scene_path, out, quiet, resume=False, checkpoint_every=60.0, overrides=
 def _check(scene_path, overrides=()):
     import numpy as np
 
-    from .remesh import describe_refinement
+    from .geometry.remesh import describe_refinement
 
     started = time.perf_counter()        # the estimate's trial answers within 30 s of this
     scene, model, limit = _prepare(scene_path, overrides)
@@ -357,13 +357,13 @@ def _check(scene_path, overrides=()):
         stable += f"; {model.dt_reason}"
     print(f"  dt {model.dt:.3g} s, {stable}, {model.n_steps} steps, "
           f"{len(model.frame_steps)} frames, {len(model.sample_steps)} history rows")
-    from .model import initial_state
+    from .model.build import initial_state
 
     state = initial_state(model)        # describe reads it, the estimate steps it
     for line in model.dynamics.describe(model, state):
         print(f"  {line}")
     if model.elastic is not None:
-        from .elastic import describe
+        from .contact.elastic import describe
 
         lines, warnings = describe(model, state)
         for line in lines:
@@ -375,11 +375,11 @@ def _check(scene_path, overrides=()):
         print(f"  cycle jumping: {model.cycle_steps} steps per cycle, {cycles:.6g} cycles, "
               f"{scene.wear.jump} jumps, tolerance {scene.wear.tolerance:g}; outputs inside "
               "jumps are filled from them")
-    from .remesh import spacing_notices
+    from .geometry.remesh import spacing_notices
 
     for line in spacing_notices(model, state):
         print(f"  notice: {line}")
-    from .estimate import estimate_run
+    from .step.estimate import estimate_run
 
     e = estimate_run(model, state, started)
     full = "" if not model.cycle_steps else (
@@ -480,7 +480,7 @@ def _plot(args):
 
 
 def _info(mesh_path, units):
-    from .geometry import mesh_info
+    from .geometry.properties import mesh_info
 
     info = mesh_info(mesh_path, units)
     for key, value in info.items():
@@ -533,7 +533,7 @@ class _StopRequests:
 
     def __call__(self, model, state):
         if self.requested:
-            from .checkpoint import save
+            from .longrun.checkpoint import save
 
             save(self.saver.path, model, state, self.saver.wall_time)
             raise _Stopped(self.terminated)

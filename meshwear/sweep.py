@@ -21,7 +21,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from .scene import SceneError, parse_override
+from .scene.format import SceneError, parse_override
 
 #: modes of combining the varied values
 MODES = ("grid", "list")
@@ -113,7 +113,7 @@ def run_one(scene, values, out_dir, numba_threads=None):
 
         numba.set_num_threads(min(int(numba_threads), numba.config.NUMBA_NUM_THREADS))
     from .api import load, run
-    from .simulate import NumericalError
+    from .step.simulate import NumericalError
 
     try:
         result = run(load(scene, values), out=out_dir)

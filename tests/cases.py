@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from meshwear.kernels.contact import rotation_entries
-from meshwear.scene import load_scene
-from meshwear.simulate import run_scene
+from meshwear.scene.format import load_scene
+from meshwear.step.simulate import run_scene
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 VALIDATION = EXAMPLES / "validation"
@@ -320,7 +320,7 @@ def fretting_loop(grid, pressure, mu, top, points=41):
     tangential force from +top to -top and back, each point a segment from
     its turning point's shear; its area (J) and the shifts at the two
     turning points (m)."""
-    from meshwear.halfspace import solve_shear
+    from meshwear.contact.halfspace import solve_shear
 
     q_top, _, s_top = solve_shear(grid, pressure, mu, top)
     q_bottom, _, s_bottom = solve_shear(grid, pressure, mu, -top, q_top, top, s_top)
@@ -332,7 +332,7 @@ def fretting_loop(grid, pressure, mu, top, points=41):
 
 def _hertz(scene):
     """Hertz's a, p0 and approach for the half-space ball ``scene``."""
-    from meshwear.halfspace import contact_modulus
+    from meshwear.contact.halfspace import contact_modulus
 
     c = scene.contact
     e_star = contact_modulus(c.youngs_modulus, c.poissons_ratio)
@@ -362,7 +362,7 @@ def cell_radii(patch):
 def hertz_ball():
     """A ball pressed on a flat, half-space contact: Hertz's ellipse, on the
     grid and at the vertices."""
-    from meshwear.model import build_model, initial_state
+    from meshwear.model.build import build_model, initial_state
     from meshwear.output.fields import body_quantities
 
     scene = load_scene(VALIDATION / "hertz_ball.toml")
@@ -395,8 +395,8 @@ def hertz_ball():
 def mindlin_fretting():
     """The ball rubbed in partial slip: Cattaneo-Mindlin's force and stick
     radius, Mindlin and Deresiewicz's energy per cycle."""
-    from meshwear.model import build_model, initial_state
-    from meshwear.simulate import step
+    from meshwear.model.build import build_model, initial_state
+    from meshwear.step.simulate import step
 
     scene = load_scene(VALIDATION / "mindlin_fretting.toml")
     model = build_model(scene)
@@ -441,7 +441,7 @@ def halfspace_grid():
     steel: Hertz's cylinder, the rigid flat punch, Cattaneo-Mindlin's stick
     radius and Mindlin-Deresiewicz's energy at three tangential loads (the
     sphere's Hertz rows are the hertz_ball case's, on a mesh)."""
-    from meshwear.halfspace import contact_modulus, make_grid, solve, solve_shear
+    from meshwear.contact.halfspace import contact_modulus, make_grid, solve, solve_shear
 
     E, nu, R, P, mu = 210e9, 0.3, 0.01, 10.0, 0.5
     e_star = contact_modulus((E, E), (nu, nu))

@@ -186,8 +186,8 @@ def probe(scene_path, overrides=(), steps=PROBE_STEPS):
     from meshwear import cli
 
     def work():
-        from meshwear import stepper
-        from meshwear.model import initial_state
+        from meshwear.step import stepper
+        from meshwear.model.build import initial_state
         from meshwear.output.recorder import RunRecorder
 
         scene, model, _ = cli._prepare(scene_path, overrides)
@@ -196,7 +196,7 @@ def probe(scene_path, overrides=(), steps=PROBE_STEPS):
             recorder = RunRecorder(Path(out) / "run", model)
             recorder.on_frame(model, state)
             stepper.advance(model, state, min(model.n_steps, steps))
-            from meshwear.simulate import check
+            from meshwear.step.simulate import check
             check(model, state, [b.reference_face_normals for b in model.bodies])
             recorder.finish()
         return 0

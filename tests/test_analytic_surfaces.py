@@ -14,9 +14,9 @@ import pytest
 import reference
 from meshwear import geometry
 from meshwear.kernels import analytic, frames
-from meshwear.model import build_model, initial_state
-from meshwear.scene import RotationConfig, load_scene
-from meshwear.simulate import run_scene, step
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import RotationConfig, load_scene
+from meshwear.step.simulate import run_scene, step
 from meshwear.surfaces import MeshSurface
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -340,7 +340,7 @@ def test_a_cylinder_shape_turning_about_its_axis_deviates_by_its_facets_sag():
     O(sections²), 5-9 s for 10 000). Off its axis it is sampled as before."""
     import time
 
-    from meshwear.scene import ShapeConfig
+    from meshwear.scene.format import ShapeConfig
 
     def shaped(sections, **kwargs):
         ring = _ring(sections, **kwargs)

@@ -13,7 +13,7 @@ import trimesh
 import meshwear
 from meshwear.cli import main
 from meshwear.kernels.contact import rotation_entries
-from meshwear.scene import SceneError, load_scene
+from meshwear.scene.format import SceneError, load_scene
 from test_counter_wear import PIN_ON_WORN_DISC
 
 #: a tenth of a turn of the pin on a worn disc: both parts wear

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from meshwear.cli import main
-from meshwear.model import (AUTO_STEPS_PER_CYCLE, AUTO_STEPS_PER_RUN, build_model,
-                            check_time_step, stable_time_step)
-from meshwear.scene import SceneError, load_scene
+from meshwear.model.build import (AUTO_STEPS_PER_CYCLE, AUTO_STEPS_PER_RUN, build_model,
+                                  check_time_step, stable_time_step)
+from meshwear.scene.format import SceneError, load_scene
 
 # the issue's minimal scene: a steel block dropped on a floor, nothing but
 # what it needs (stiffness 1e9 N/m per vertex: the default 1e-5 s was unstable)
@@ -126,7 +126,7 @@ def test_an_explicit_step_above_the_limit_is_refused_with_the_limit(tmp_path):
 
 
 def test_check_s_estimate_counts_the_outputs_and_caps_jumps_at_resolved(tmp_path):
-    from meshwear.estimate import estimate_run
+    from meshwear.step.estimate import estimate_run
 
     few = build_model(load_scene(write(tmp_path, PIN.format(mode="quasi-static", wear="")),
                                  [("run.frames", 2), ("run.history", 2)]))
@@ -152,8 +152,8 @@ def test_check_s_estimate_counts_a_return_to_python_per_output(tmp_path, monkeyp
     case writing a row every step had half its run estimated)."""
     import time
 
-    from meshwear import estimate, simulate
-    from meshwear.model import initial_state
+    from meshwear.step import estimate, simulate
+    from meshwear.model.build import initial_state
 
     model = build_model(load_scene(write(tmp_path, PIN.format(mode="quasi-static", wear="")),
                                    [("run.frames", 3), ("run.history", 50)]))
@@ -180,8 +180,8 @@ def test_check_writes_no_trial_frame_for_a_run_without_frames(tmp_path, monkeypa
     none either (one frame of a 52 000-vertex ball, 0.13 s, made a 0.3 s
     validation case's estimate half as long again); history rows are
     written and timed as before."""
-    from meshwear import estimate
-    from meshwear.model import initial_state
+    from meshwear.step import estimate
+    from meshwear.model.build import initial_state
     from meshwear.output.recorder import RunRecorder
 
     written = []
@@ -200,8 +200,8 @@ def test_a_jump_trial_stopped_inside_a_cycle_counts_its_steps():
     """The cost of a resolved cycle from ``meshwear check``'s jumping trial:
     a trial that stopped half-way through its third resolved cycle resolved
     2.5 cycles, not 2; the outputs filled from jumps are costed apart."""
-    from meshwear.estimate import _per_cycle
-    from meshwear.wear import JumpState
+    from meshwear.step.estimate import _per_cycle
+    from meshwear.longrun.wear import JumpState
 
     n_c = 100
     js = JumpState(resolved_steps=2 * n_c, cycle_start=3 * n_c, fill_seconds=1.0)

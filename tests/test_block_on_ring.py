@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from meshwear.model import build_model, initial_state
-from meshwear.scene import load_scene
-from meshwear.simulate import run
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import load_scene
+from meshwear.step.simulate import run
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 R, P, K, WIDTH = 0.0175, 10.0, 4e-14, 0.01

@@ -12,8 +12,8 @@ import pytest
 import trimesh
 
 from meshwear.cli import main
-from meshwear.geometry import CAD_EXTRA, MeshError, load_mesh
-from meshwear.scene import SceneError, load_scene
+from meshwear.geometry.meshes import CAD_EXTRA, MeshError, load_mesh
+from meshwear.scene.format import SceneError, load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 STEP = ROOT / "meshes" / "pin_d6_h10_mm.step"

@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 
 import cases
-from meshwear import estimate
+from meshwear.step import estimate
 from meshwear.cli import main
-from meshwear.estimate import _cycles_left, _forecast, _jump_at, _trend_range
-from meshwear.model import build_model, initial_state
-from meshwear.scene import load_scene
-from meshwear.simulate import run
-from meshwear.wear import GROWTH
+from meshwear.step.estimate import _cycles_left, _forecast, _jump_at, _trend_range
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import load_scene
+from meshwear.step.simulate import run
+from meshwear.longrun.wear import GROWTH
 
 
 # ---------------------------------------------------------------- the rule, in closed form

@@ -25,7 +25,8 @@ import trimesh
 import vtk
 from vtk.util.numpy_support import vtk_to_numpy
 
-from meshwear import geometry, remesh
+from meshwear import geometry
+from meshwear.geometry import remesh
 from meshwear.cli import main
 
 #: docs/outputs.md: history.csv starts with these columns, in this order
@@ -584,7 +585,7 @@ def test_non_finite_state_stops_with_exit_3(tmp_path, capsys, caplog, monkeypatc
     """A state that turns NaN mid-run (injected once the run passes step 400
     of 1000) stops the run at the next sample with exit 3; the samples before
     it stay valid."""
-    import meshwear.stepper
+    import meshwear.step.stepper
 
     real_advance = meshwear.stepper.advance
 
@@ -682,9 +683,9 @@ def test_installed_command_refuses_a_bad_scene(tmp_path):
 
 
 def test_progress_is_reported_between_sparse_samples(tmp_path):
-    from meshwear.model import build_model, initial_state
-    from meshwear.scene import load_scene
-    from meshwear.simulate import PROGRESS_STEPS, run
+    from meshwear.model.build import build_model, initial_state
+    from meshwear.scene.format import load_scene
+    from meshwear.step.simulate import PROGRESS_STEPS, run
 
     scene = write(tmp_path / "scene.toml", BASE.replace("history = 5", "history = 2").replace(
         "duration = 0.01", "duration = 0.05"))

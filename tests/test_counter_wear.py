@@ -12,13 +12,13 @@ import pyvista
 
 import cases
 import reference
-from meshwear import checkpoint, jumps
+from meshwear.longrun import checkpoint, jumps
 from meshwear.cli import main
 from meshwear.kernels import counter_wear
 from meshwear.kernels.counter_wear import settle_counter, wear_counter
-from meshwear.model import build_model, initial_state
-from meshwear.scene import SceneError, load_scene
-from meshwear.simulate import NumericalError, run
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import SceneError, load_scene
+from meshwear.step.simulate import NumericalError, run
 
 #: a flat pin (radius a = 1 mm) held R = 5 mm off the axis of a disc turning
 #: at 10 rad/s, pressed by P = 10 N (quasi-static, Archard); both wear, the
@@ -347,7 +347,7 @@ def test_a_checkpoint_carries_the_counter_wear(tmp_path):
     full = run(model, initial_state(model))
     depth = full.parts[0].depth.copy()
     half = initial_state(model)
-    from meshwear.simulate import advance
+    from meshwear.step.simulate import advance
     advance(model, half, model.n_steps // 2)
     checkpoint.save(tmp_path / "c.npz", model, half, 0.0)
     resumed = initial_state(model)
@@ -436,7 +436,7 @@ def _relaxations(monkeypatch, model):
     relaxation time and what it is over the vertices in contact (pressing
     in the cycle): the median of 1 / alpha and of 1 / (alpha + gamma), and
     how many press of how many may touch (gamma None: not yet known)."""
-    from meshwear import wear
+    from meshwear.longrun import wear
 
     seen = []
     relaxation = wear._relaxation
@@ -905,7 +905,7 @@ def test_counter_noise_is_the_scatter_about_the_rates_drift():
     however long the jumps between the measurements) is no noise; a vertex
     touched every other cycle, or whose rate scatters, is; fewer than three
     measurements, not yet measured."""
-    from meshwear.wear import JumpState, _counter_noise
+    from meshwear.longrun.wear import JumpState, _counter_noise
 
     base = np.array([1.0e-9, 2.0e-9, 0.0])
     drifting = [(t, None, [base * (1.0 - 0.002 * t)]) for t in (10.0, 50.0, 51.0)]
@@ -930,7 +930,7 @@ def test_a_counter_vertex_the_contact_reaches_settles_without_noise():
     fretting example: a flat vertex at the scar's corner given a noise 1.6
     times its rate, 40 times what eight resolved cycles in a row scatter,
     held the jumps). Independent scatter is still counted."""
-    from meshwear.wear import _fit, _local_scatter
+    from meshwear.longrun.wear import _fit, _local_scatter
 
     t = 4000.0 + 17.0 * np.arange(8)
     settling = 1e-9 * (1.0 - np.exp(-(t - 3990.0) / 40.0))
@@ -951,7 +951,7 @@ def test_an_error_the_contact_has_left_over_the_tolerance_does_not_refuse_every_
     that tolerance: a jump that adds nothing to it passes, one that adds
     its noise is bounded, and a wearing vertex over it still refuses (the
     resolved cycles relax it)."""
-    from meshwear.wear import _noise_bound
+    from meshwear.longrun.wear import _noise_bound
 
     tol, deepest, fastest, relax = 0.01, 3.2e-6, 5e-10, 300.0
     over = (1.1 * tol * deepest) ** 2

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 import cases
-from meshwear.model import build_model, initial_state
-from meshwear.scene import load_scene
-from meshwear.simulate import run, run_scene
-from meshwear.wear import GROWTH, THETA, _grows_from, choose_jump, error_estimate
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import load_scene
+from meshwear.step.simulate import run, run_scene
+from meshwear.longrun.wear import GROWTH, THETA, _grows_from, choose_jump, error_estimate
 
 
 # ---------------------------------------------------------------- controller
@@ -385,8 +385,8 @@ def test_an_implicit_jump_s_errors_hold_its_drift_and_relax_as_the_contact_does(
     relaxes them: a vertex worn too little carries more and wears more),
     and their stiffness-weighted mean, the drift's signed, which the relief
     does not take off, is kept apart (docs/model.md, "Long durations")."""
-    from meshwear.jumps import BodyJump, implicit
-    from meshwear.wear import JumpState, _choose_implicit
+    from meshwear.longrun.jumps import BodyJump, implicit
+    from meshwear.longrun.wear import JumpState, _choose_implicit
 
     k, p = 3, 1e-6
     alpha = np.full(k, 1e-3)                        # wear per cycle per unit penetration
@@ -436,7 +436,7 @@ def test_jumps_of_a_loaded_pad_keep_archard_s_volume_when_both_parts_wear(monkey
     wears the same volume."""
     from pathlib import Path
 
-    from meshwear import wear
+    from meshwear.longrun import wear
 
     path = Path(__file__).resolve().parents[1] / "examples" / "cylinder_on_flat_fretting.toml"
     settings = [("run.duration", 200.0), ("body[0].resolution", 4e-5),
@@ -468,7 +468,7 @@ def test_the_implicit_step_kernel_matches_its_numpy_twin(monkeypatch):
     flat: guided, the counter's gamma; a pin on a worn disc), at jumps of
     1 to 10^4 cycles, and without a free axis or members."""
     import reference
-    from meshwear import jumps
+    from meshwear.longrun import jumps
     from meshwear.kernels.balance import implicit_step
 
     seen = []
@@ -514,8 +514,8 @@ def test_a_jump_keeps_its_volume_along_the_change_of_every_alpha_alike():
     pressed along the axis wears the same more, keeping the shape the jump
     wore (scaling every vertex's wear there left the block-on-ring scar's
     edge 4.2 % of its depth off the ring's arc)."""
-    from meshwear.jumps import BodyJump, single_step
-    from meshwear.wear import _volume_direction
+    from meshwear.longrun.jumps import BodyJump, single_step
+    from meshwear.longrun.wear import _volume_direction
 
     p = np.array([1.0, 1.2, 0.8, 1.1]) * 1e-6
     c = np.full(4, 1e6)
@@ -552,7 +552,7 @@ def test_a_vertex_touched_but_not_at_the_cycle_s_end_wears_at_most_twice_its_mea
     pressed them by the pinion's whole approach): over a jump its wear per
     cycle at most doubles (TOUCHED_GROWTH), its relief still slowing it
     (docs/model.md, "Long durations")."""
-    from meshwear.jumps import TOUCHED_GROWTH, BodyJump, _step, implicit
+    from meshwear.longrun.jumps import TOUCHED_GROWTH, BodyJump, _step, implicit
 
     k, p, load = 3, 1e-6, 2.0
     # vertices 0 and 1 carry the load along -z; vertex 2 touched the mate in
@@ -588,7 +588,7 @@ def test_a_touched_vertex_takes_its_counter_s_wear_where_it_pressed():
     (docs/model.md, "Worn counter-surfaces")."""
     from types import SimpleNamespace
 
-    from meshwear.jumps import BodyJump, counter_relief, pair_log, start_log
+    from meshwear.longrun.jumps import BodyJump, counter_relief, pair_log, start_log
 
     # vertex 0 in contact at the cycle's end, vertex 1 touched in the cycle
     # only; neither over a face of the counter at the cycle's end (their feet

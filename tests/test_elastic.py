@@ -7,11 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from meshwear.halfspace import contact_modulus
+from meshwear.contact.halfspace import contact_modulus
 from meshwear.kernels.contact import STICK
-from meshwear.model import build_model, initial_state
-from meshwear.scene import SceneError, load_scene
-from meshwear.simulate import NumericalError, step
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import SceneError, load_scene
+from meshwear.step.simulate import NumericalError, step
 
 from cases import cell_radii, ellipse_radius
 
@@ -284,7 +284,7 @@ def test_the_patch_is_triangulated_on_one_blas_thread(tmp_path, monkeypatch):
     from scipy.spatial import Delaunay
     from threadpoolctl import threadpool_info, threadpool_limits
 
-    from meshwear import elastic
+    from meshwear.contact import elastic
 
     threads = []
 
@@ -370,7 +370,7 @@ def test_cycle_jumps_wear_a_fretting_ball_as_its_resolved_cycles():
     and with implicit jumps: the same scar. (A jump that took the rigid
     overlap of the ring just outside the elastic contact, out to sqrt(2) a,
     for a penetration wore that ring and under-wore the annulus by 23 %.)"""
-    from meshwear.simulate import run
+    from meshwear.step.simulate import run
 
     path = Path(__file__).resolve().parents[1] / "examples" / "sphere_on_flat_fretting_elastic.toml"
     depths = {}
@@ -409,7 +409,7 @@ coefficient = 1e-12
                         "amplitude = 3e-6, frequency = 20.0 }\n")
     path = tmp_path / "mesh_flat.toml"
     path.write_text(text)
-    from meshwear.simulate import run
+    from meshwear.step.simulate import run
 
     model = build_model(load_scene(path))
     state = run(model, initial_state(model))

@@ -69,7 +69,7 @@ def test_overflowing_and_zero_vectors(key, value):
 
 def test_an_overflowing_direction_is_normalised_not_zeroed():
     # [1.7e308]*3 used to normalise to zero: the load was ignored and the block floated
-    from meshwear.scene import load_scene
+    from meshwear.scene.format import load_scene
 
     scene = load_scene(EXAMPLES / "pin_on_disc.toml", (("body[0].path.free_axis", [0.0, 0.0, HUGE]),))
     assert scene.bodies[0].path.free_axis == (0.0, 0.0, 1.0)
@@ -146,15 +146,15 @@ def test_the_limit_sample_has_each_kind():
 
 
 def test_a_slender_cylinder_is_closed():
-    from meshwear import geometry
+    from meshwear.geometry import meshes
 
-    v, f = geometry.primitive("cylinder", radius=1e-5, height=0.1, sections=32)
-    assert geometry._is_closed(f)
-    assert geometry._doubled_areas(v, f).min() > 0.0
+    v, f = meshes.primitive("cylinder", radius=1e-5, height=0.1, sections=32)
+    assert meshes._is_closed(f)
+    assert meshes._doubled_areas(v, f).min() > 0.0
 
 
 def test_cycle_jumping_refuses_too_few_steps_per_cycle():
-    from meshwear.model import MIN_CYCLE_STEPS
+    from meshwear.model.build import MIN_CYCLE_STEPS
 
     outcome = probe(EXAMPLES / "long" / "sphere_fretting_1e5.toml", (("run.dt", 0.5),))  # 1 Hz: 2 a cycle
     assert outcome.code == 2 and f"at least {MIN_CYCLE_STEPS}" in outcome.stderr, outcome

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 import trimesh
 
-from meshwear import geometry, remesh
-from meshwear.geometry import MeshError
+from meshwear import geometry
+from meshwear.geometry import meshes, remesh
+from meshwear.geometry.meshes import MeshError
 
 
 def watertight(vertices, faces):
@@ -130,7 +131,7 @@ def test_exact_copies_group_the_rows_as_numpys_unique_does():
     for _ in range(100):
         v = rng.integers(-2, 3, (int(rng.integers(1, 80)), 3)).astype(float) * 0.25
         v[v == 0.0] *= rng.choice([1.0, -1.0], int((v == 0.0).sum()))        # signed zeros
-        rows, first, inverse = geometry._exact_copies(v)
+        rows, first, inverse = meshes._exact_copies(v)
         want, want_first, want_inverse = np.unique(v, axis=0, return_index=True,
                                                    return_inverse=True)
         assert len(rows) == len(want) and sorted(first) == sorted(want_first)
@@ -144,8 +145,8 @@ def test_exact_copies_group_the_rows_as_numpys_unique_does():
 def test_a_mesh_file_is_read_once_per_model(monkeypatch):
     """The gear pair's two gears are one file, and a refined body's mesh is
     read for the checks before refining too: each read once per build."""
-    from meshwear.model import build_model
-    from meshwear.scene import load_scene
+    from meshwear.model.build import build_model
+    from meshwear.scene.format import load_scene
 
     reads = []
     load = geometry.load_mesh
@@ -455,8 +456,8 @@ def test_a_ball_is_refined_within_its_resolution_reach_not_over_its_coarse_faces
     resolution (the last split's parent) above it. (Taken whole, the coarse
     faces a millimetre wide under the ball were refined to 123 um above the
     plane: 50 172 vertices where 11 730 do.)"""
-    from meshwear.model import build_model
-    from meshwear.scene import load_scene
+    from meshwear.model.build import build_model
+    from meshwear.scene.format import load_scene
 
     path = tmp_path / "ball.toml"
     path.write_text(BALL_ON_A_PLANE)
@@ -483,7 +484,7 @@ def test_refined_primitives_put_their_vertices_on_the_exact_surface():
     towards the axis by up to R (1 - cos(pi / sections)): 0.45 um for R = 6 mm
     and 256 sections); the caps stay flat; the facets then sag at most
     SAG_FRACTION of the resolution where refined."""
-    from meshwear.scene import ShapeConfig
+    from meshwear.scene.format import ShapeConfig
 
     class Part:
         def __init__(self, shape, resolution):

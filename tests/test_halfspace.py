@@ -6,7 +6,7 @@ energy per fretting cycle. Two steel bodies, E = 210 GPa, nu = 0.3."""
 import numpy as np
 import pytest
 
-from meshwear.halfspace import contact_modulus, make_grid, solve, solve_shear
+from meshwear.contact.halfspace import contact_modulus, make_grid, solve, solve_shear
 
 from cases import fretting_loop, mindlin_deresiewicz
 

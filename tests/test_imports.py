@@ -1,5 +1,6 @@
-"""The package's layering: lower modules never import higher ones, so any
-module can be imported first (docs/index.md, "Code map")."""
+"""The package's layering (docs/index.md, "Code map"): the stages, bottom up,
+each importing only its own stage and the stages below it, so any module can
+be imported first."""
 
 import ast
 import subprocess
@@ -9,9 +10,15 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "meshwear"
 
+#: the stages, bottom up: a module of one imports only modules of its own
+#: stage and of the stages before it ("top" is the package itself and the
+#: interfaces on it: api, cli, sweep, and the old paths' finder)
+STAGES = ["kernels", "geometry", "scene", "motion", "surfaces", "contact", "mechanism", "model",
+          "output", "longrun", "step", "top"]
+
 #: the step loop's two halves: the compiled loop hands steps it does not take
 #: back to the Python reference step, and that step runs on the compiled loop
-ALLOWED_CYCLES = [{"meshwear.simulate", "meshwear.stepper"}]
+ALLOWED_CYCLES = [{"meshwear.step.simulate", "meshwear.step.stepper"}]
 
 
 def _modules():
@@ -75,17 +82,53 @@ def test_no_import_cycles_but_the_step_loops_halves():
     modules = _modules()
     graph = {name: _imports(name, path, modules) for name, path in modules.items()}
     # the finder must see real edges, or the test proves nothing
-    assert "meshwear.wear" in graph["meshwear.simulate"]
-    assert "meshwear.simulate" in graph["meshwear.stepper"]
+    assert "meshwear.longrun.wear" in graph["meshwear.step.simulate"]
+    assert "meshwear.step.simulate" in graph["meshwear.step.stepper"]
     cycles = [c for c in _cycles(graph) if c not in ALLOWED_CYCLES]
     assert not cycles, f"import cycles: {cycles}"
-    # cycle jumping is driven by the step loop, never the other way round
-    for low in ("meshwear.wear", "meshwear.jumps", "meshwear.output.filled"):
-        assert "meshwear.simulate" not in graph[low], low
+
+
+def _stage(name):
+    parts = name.split(".")
+    return parts[1] if len(parts) > 2 or (len(parts) == 2 and parts[1] in STAGES) else "top"
+
+
+def test_a_stage_imports_only_its_own_and_the_stages_below():
+    modules = _modules()
+    assert {_stage(m) for m in modules} == set(STAGES), "a folder that is no stage"
+    wrong = []
+    for name, path in modules.items():
+        rank = STAGES.index(_stage(name))
+        for target in _imports(name, path, modules):
+            if STAGES.index(_stage(target)) > rank:
+                wrong.append(f"{name} imports {target}")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_the_old_module_paths_warn_and_give_the_new_modules():
+    code = ("import warnings, importlib; warnings.simplefilter('error');\n"
+            "from meshwear._moved import MOVED\n"
+            "for old, new in MOVED.items():\n"
+            "    try:\n"
+            "        importlib.import_module(old)\n"
+            "    except DeprecationWarning as w:\n"
+            "        assert new in str(w), w\n"
+            "    else:\n"
+            "        raise SystemExit(old + ' gave no warning')\n"
+            "warnings.simplefilter('ignore')\n"
+            "for old, new in MOVED.items():\n"
+            "    m = importlib.import_module(old)\n"
+            "    assert m is importlib.import_module(new) and m.__spec__.name == new, old\n"
+            "import meshwear.simulate as s, meshwear.step.simulate as t; assert s is t\n"
+            "from meshwear import wear; assert wear.__name__ == 'meshwear.longrun.wear'\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120, cwd=ROOT)
+    assert done.returncode == 0, done.stderr.strip()[-500:]
 
 
 def test_the_modules_that_were_in_cycles_import_first():
-    for name in ("meshwear.remesh", "meshwear.wear", "meshwear.output.filled", "meshwear.jumps"):
+    for name in ("meshwear.geometry.remesh", "meshwear.longrun.wear", "meshwear.output.filled",
+                 "meshwear.longrun.jumps", "meshwear.step.simulate", "meshwear.model"):
         done = subprocess.run([sys.executable, "-c", f"import {name}"], capture_output=True,
                               text=True, timeout=120, cwd=ROOT)
         assert done.returncode == 0, f"import {name} first: {done.stderr.strip()[-300:]}"

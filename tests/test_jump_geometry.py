@@ -5,10 +5,11 @@ import numpy as np
 import pytest
 
 import cases
-from meshwear import geometry, jump_geometry, wear
-from meshwear.model import build_model, initial_state
-from meshwear.scene import load_scene
-from meshwear.simulate import inverted, run
+from meshwear import geometry
+from meshwear.longrun import jump_geometry, wear
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import load_scene
+from meshwear.step.simulate import inverted, run
 
 #: a 10 mm ball fretting +-0.1 mm under 50 N on a plane, archard, cycle jumping
 #: to a cap 1.69 mm deep: the reported 2e4 cycles at k = 1e-10 shortened to

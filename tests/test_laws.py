@@ -7,7 +7,7 @@ import pytest
 from numba import njit
 
 from meshwear.kernels import laws
-from meshwear.scene import SceneError, WearConfig
+from meshwear.scene.format import SceneError, WearConfig
 
 
 @njit(cache=True)

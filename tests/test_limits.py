@@ -12,10 +12,11 @@ from pathlib import Path
 import pytest
 
 import meshwear
-from meshwear import api, remesh
+from meshwear import api
+from meshwear.geometry import remesh
 from meshwear.cli import main
 from meshwear.output import recorder
-from meshwear.scene import SceneError
+from meshwear.scene.format import SceneError
 
 ROOT = Path(__file__).resolve().parents[1]
 POD = str(ROOT / "examples" / "pin_on_disc.toml")
@@ -53,7 +54,7 @@ def test_a_refinement_larger_than_memory_is_refused_before_refining(monkeypatch,
 
 def test_history_kept_in_memory_beyond_the_available_memory_is_refused(monkeypatch):
     from meshwear.api import ROW_BYTES
-    from meshwear.model import build_model
+    from meshwear.model.build import build_model
 
     scene = meshwear.load(POD, {"run.duration": 0.2, "run.history": 1001})
     model = build_model(scene)

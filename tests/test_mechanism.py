@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 
 import cases
-from meshwear import checkpoint
+from meshwear.longrun import checkpoint
 from meshwear.cli import main
-from meshwear.mechanism import slot_wrench
-from meshwear.model import build_model, check_time_step, initial_state
+from meshwear.mechanism.build import slot_wrench
+from meshwear.model.build import build_model, check_time_step, initial_state
 from meshwear.output.memory import MemoryHistory
-from meshwear.scene import SceneError, load_scene
-from meshwear.simulate import run
+from meshwear.scene.format import SceneError, load_scene
+from meshwear.step.simulate import run
 from test_resume import _KillAt, _Stop
 
 pytest.importorskip("mujoco")
@@ -296,7 +296,7 @@ def test_active_sets_are_given_up_only_where_refreshes_come_faster_than_they_pay
     of them over the run than one trial window allows: the pin keeps its
     active set. Turning fast, the disc's rim crosses the margin every few
     steps: every vertex is checked."""
-    from meshwear.mechanism import TRIAL_REFRESHES, TRIAL_STEPS, Mechanism
+    from meshwear.mechanism.build import TRIAL_REFRESHES, TRIAL_STEPS, Mechanism
 
     count = []
     refreshed = Mechanism.refreshed
@@ -416,7 +416,7 @@ def _geom_pin(tmp_path):
     centroid) and placed back by the geom's pos and a quarter turn."""
     import trimesh
 
-    from meshwear.geometry import primitive
+    from meshwear.geometry.meshes import primitive
 
     vertices, faces = primitive("cylinder", radius=0.002, height=0.006, sections=32)
     turn = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])   # -90° about z

@@ -12,8 +12,8 @@ import trimesh
 
 import reference
 from meshwear.kernels import nearest
-from meshwear.scene import load_scene
-from meshwear.simulate import run_scene
+from meshwear.scene.format import load_scene
+from meshwear.step.simulate import run_scene
 
 RTOL = 1e-12
 
@@ -481,13 +481,13 @@ def test_an_open_sheet_counter_mesh_works_and_a_wrongly_wound_one_is_refused(tmp
     _, state, sheet = _run(tmp_path, text.replace("MESH", "up.stl"), "up")
     assert sheet.rows["block"]["friction_work"][-1] == pytest.approx(
         plane.rows["block"]["friction_work"][-1], rel=1e-9)
-    from meshwear.scene import SceneError
+    from meshwear.scene.format import SceneError
     with pytest.raises(SceneError, match=r"body\[0\].position.*inside surface 'floor'"):
         _run(tmp_path, text.replace("MESH", "down.stl"), "down")
 
 
 def test_a_degenerate_counter_mesh_is_refused_naming_the_key(tmp_path):
-    from meshwear.scene import SceneError
+    from meshwear.scene.format import SceneError
 
     line = np.array([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.02, 0.0, 0.0]])
     path = tmp_path / "flat.obj"
@@ -582,10 +582,10 @@ def test_turning_disc_cycle_jump_resumes_to_the_same_wear_and_writes_its_series(
     import json
     import xml.etree.ElementTree as ET
 
-    from meshwear import checkpoint
+    from meshwear.longrun import checkpoint
     from meshwear.cli import main
-    from meshwear.model import build_model, initial_state
-    from meshwear.simulate import run
+    from meshwear.model.build import build_model, initial_state
+    from meshwear.step.simulate import run
 
     path = tmp_path / "disc.toml"
     path.write_text(PIN_ON_DISC.format(duration=30.0)
@@ -651,9 +651,9 @@ def test_the_active_set_changes_no_result(tmp_path, plate):
     same numbers, while most steps process few vertices."""
     import dataclasses
 
-    from meshwear.model import build_model, initial_state
+    from meshwear.model.build import build_model, initial_state
     from meshwear.output.memory import MemoryHistory
-    from meshwear.simulate import run
+    from meshwear.step.simulate import run
 
     root = __import__("pathlib").Path(__file__).resolve().parents[1]
     source = root / "examples" / "cube_toss.toml"
@@ -688,9 +688,9 @@ def test_cad_part_example_refines_only_where_it_can_touch_and_wears_k_load_dista
     strokes on the rail mesh wear V = k P s (gross sliding)."""
     import dataclasses
 
-    from meshwear.geometry import face_normals, load_mesh
-    from meshwear.model import build_model, initial_state
-    from meshwear.simulate import run
+    from meshwear.geometry.meshes import face_normals, load_mesh
+    from meshwear.model.build import build_model, initial_state
+    from meshwear.step.simulate import run
 
     root = __import__("pathlib").Path(__file__).resolve().parents[1]
     scene = load_scene(root / "examples" / "cad_part.toml")
@@ -733,7 +733,7 @@ def test_the_collision_manager_names_the_mesh_surfaces_a_body_comes_near(tmp_pat
              'position = [0.0, 0.0102, 0.0075]\n')
     path = tmp_path / "three.toml"
     path.write_text(text)
-    from meshwear.model import build_model
+    from meshwear.model.build import build_model
 
     model = build_model(load_scene(path))
     body = model.bodies[0]
@@ -782,8 +782,8 @@ def test_the_active_set_changes_no_result_on_a_turning_mesh_in_mesh():
     the worn volume after a quarter revolution 0.6 % off the run without it."""
     import dataclasses
 
-    from meshwear import stepper
-    from meshwear.model import build_model, initial_state
+    from meshwear.step import stepper
+    from meshwear.model.build import build_model, initial_state
 
     root = __import__("pathlib").Path(__file__).resolve().parents[1]
     model = build_model(load_scene(root / "examples" / "gear_pair.toml"))
@@ -845,7 +845,7 @@ def test_a_worn_surface_is_refined_only_where_a_body_reaches_it(tmp_path):
     under the stroke and the margin around it (every face some pad vertex
     comes within the margin of, at any instant of the cycle), not all over:
     its sides and the rest of its top keep their triangles."""
-    from meshwear.model import build_model
+    from meshwear.model.build import build_model
 
     path = tmp_path / "stroke.toml"
     path.write_text(STROKE.format(resolution=5e-4))
@@ -893,7 +893,9 @@ def test_the_early_refusal_counts_only_surface_the_refined_bodies_reach(stem, sh
     is small anyway."""
     import dataclasses
 
-    from meshwear import geometry, model as model_, reach, surfaces
+    from meshwear import model as model_, surfaces
+    from meshwear.geometry import meshes
+    from meshwear.model import reach
 
     scene = load_scene(f"examples/{stem}.toml")
     built = [surfaces.build_surface(s) for s in scene.surfaces]
@@ -912,7 +914,7 @@ def test_the_early_refusal_counts_only_surface_the_refined_bodies_reach(stem, sh
     reached = reach.surface_faces_to_refine(scene, surface, refined, periods, 1.0).within
     rng = np.random.default_rng(1)
     V, F = surface.vertices, surface.faces
-    areas = geometry._doubled_areas(V, F)
+    areas = meshes._doubled_areas(V, F)
     pick = np.minimum(np.searchsorted(np.cumsum(areas), rng.random(100_000) * areas.sum()),
                       len(F) - 1)
     u, v = rng.random((2, len(pick)))

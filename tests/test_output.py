@@ -12,7 +12,8 @@ from vtk.util.numpy_support import vtk_to_numpy
 
 from meshwear import geometry
 from meshwear.output.tables import HISTORY_COLUMNS, HistoryWriter, write_json_atomic
-from meshwear.output.vtk import PVDSeries, plane_patch
+from meshwear.geometry import plane_patch
+from meshwear.output.vtk import PVDSeries
 
 TIMES = (0.0, 0.1, 0.30000000000000004)
 

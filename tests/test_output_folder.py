@@ -9,12 +9,12 @@ from pathlib import Path
 
 import pytest
 
-from meshwear import checkpoint
+from meshwear.longrun import checkpoint
 from meshwear.cli import main
-from meshwear.model import build_model, initial_state
+from meshwear.model.build import build_model, initial_state
 from meshwear.output.recorder import RunRecorder
-from meshwear.scene import load_scene
-from meshwear.simulate import advance
+from meshwear.scene.format import load_scene
+from meshwear.step.simulate import advance
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "pin_on_disc.toml"

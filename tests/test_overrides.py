@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from meshwear import checkpoint
+from meshwear.longrun import checkpoint
 from meshwear.cli import main
-from meshwear.model import build_model, initial_state
-from meshwear.scene import SceneError, load_scene, parse_override, set_key
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import SceneError, load_scene, parse_override, set_key
 
 ROOT = Path(__file__).resolve().parents[1]
 POD = str(ROOT / "examples" / "pin_on_disc.toml")

@@ -11,9 +11,9 @@ import pytest
 from reference import FACING, contact_areas, point_coefficients
 
 from meshwear.kernels.contact import rotation_entries
-from meshwear.model import stable_time_step, build_model
-from meshwear.scene import SceneError, load_scene
-from meshwear.simulate import run_scene
+from meshwear.model.build import stable_time_step, build_model
+from meshwear.scene.format import SceneError, load_scene
+from meshwear.step.simulate import run_scene
 
 G = 9.81
 

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import cases
-from meshwear.model import build_model, initial_state, stable_time_step
-from meshwear.scene import load_scene
-from meshwear.simulate import run_scene
+from meshwear.model.build import build_model, initial_state, stable_time_step
+from meshwear.scene.format import load_scene
+from meshwear.step.simulate import run_scene
 
 
 def test_contacts_carry_the_load_at_every_sample_from_t0():

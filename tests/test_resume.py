@@ -15,11 +15,11 @@ import numpy as np
 import pytest
 
 import cases
-from meshwear import checkpoint
+from meshwear.longrun import checkpoint
 from meshwear.cli import main
-from meshwear.model import build_model, initial_state
-from meshwear.scene import load_scene
-from meshwear.simulate import run
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import load_scene
+from meshwear.step.simulate import run
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -132,7 +132,7 @@ def test_progress_lines_when_not_a_terminal(tmp_path, monkeypatch, capsys):
     err = capsys.readouterr().err
     assert err.startswith("meshwear: 25.0 % t = ") and "eta" in err and err.count("\n") == 1
     # with cycle jumping, the last jump and its bound
-    from meshwear.wear import JumpState
+    from meshwear.longrun.wear import JumpState
 
     model = build_model(load_scene(_block_scene(tmp_path, 0.05)))
     state = initial_state(model)

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from meshwear.scene import (BodyConfig, Circle, ContactConfig, Oscillation, PathConfig,
-                            RotationConfig, RunConfig, Scene, SceneError, ShapeConfig,
-                            SurfaceConfig, WearConfig, load_scene, parse_scene)
+from meshwear.scene.format import (BodyConfig, Circle, ContactConfig, Oscillation, PathConfig,
+                                   RotationConfig, RunConfig, Scene, SceneError, ShapeConfig,
+                                   SurfaceConfig, WearConfig, load_scene, parse_scene)
 
 FULL = """
 format = 1

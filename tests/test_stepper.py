@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from meshwear.jumps import LOAD_ROWS
-from meshwear.model import build_model, initial_state
-from meshwear.scene import load_scene
-from meshwear.simulate import run
+from meshwear.longrun.jumps import LOAD_ROWS
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import load_scene
+from meshwear.step.simulate import run
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -157,7 +157,7 @@ def test_a_load_nothing_carries_stops_the_compiled_loop_as_the_python_step(tmp_p
     """A finite ring slides out from under the block along its axis: the
     block's vertices pass its end, no contact is left to carry the load, and
     the quasi-static balance has no solution."""
-    from meshwear.simulate import NumericalError
+    from meshwear.step.simulate import NumericalError
 
     path = tmp_path / "away.toml"
     text = RING[:RING.index('[[surface]]\nname = "belt"')]

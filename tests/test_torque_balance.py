@@ -17,9 +17,9 @@ from meshwear.kernels import loop
 from meshwear.kernels.contact import FACING, all_vertices, rotation_entries
 from meshwear.kernels.rigid import TURNING
 from meshwear.kernels.turn_balance import balance_angle
-from meshwear.model import build_model, initial_state
-from meshwear.scene import SceneError, load_scene
-from meshwear.simulate import run, run_scene
+from meshwear.model.build import build_model, initial_state
+from meshwear.scene.format import SceneError, load_scene
+from meshwear.step.simulate import run, run_scene
 
 from cases import EXAMPLES
 
@@ -309,7 +309,7 @@ def test_a_turning_body_resumes_to_the_same_wear(tmp_path):
     resumed in a new model: the angle it settled to comes back with the
     checkpoint, and the run ends with the uninterrupted one's wear
     (docs/outputs.md, "Checkpoints": 1e-9)."""
-    from meshwear import checkpoint
+    from meshwear.longrun import checkpoint
     from test_resume import _KillAt, _Stop
 
     extra = "oscillation = { axis = [0.0, 0.0, 1.0], amplitude = 1e-4, frequency = 10.0 }"

@@ -14,11 +14,11 @@ import pytest
 import vtk
 from vtk.util.numpy_support import vtk_to_numpy
 
-from meshwear import checkpoint
+from meshwear.longrun import checkpoint
 from meshwear.cli import main
 from meshwear.output.export import part_mesh, series_frames
 from meshwear.output.vtkhdf import VTKHDFSeries, read_frames
-from meshwear.scene import SceneError, load_scene
+from meshwear.scene.format import SceneError, load_scene
 from test_resume import _block_scene, _meshwear, _rows
 
 FACES = np.array([[0, 1, 2], [0, 2, 3], [1, 3, 2]])

@@ -28,9 +28,30 @@ faces. :func:`refit` fits them anew in O(F) on the same topology.
 """
 
 import numpy as np
+
 from .jit import njit
 
-from ..geometry import morton_codes
+def morton_codes(points):
+    """(n,) uint64 Morton codes of ``points`` (n, 3): 20 bits an axis, one
+    scale for the three (so that the curve keeps distances)."""
+    if len(points) == 0:
+        return np.zeros(0, np.uint64)
+    low = points.min(axis=0)
+    span = float((points.max(axis=0) - low).max())
+    q = np.floor((points - low) / (span if span > 0.0 else 1.0) * 1048575.0).astype(np.uint64)
+    return _spread(q[:, 0]) | (_spread(q[:, 1]) << np.uint64(1)) | (_spread(q[:, 2]) << np.uint64(2))
+
+
+def _spread(x):
+    """The 20 low bits of each uint64 spread to every third bit."""
+    x = x & np.uint64(0xFFFFF)
+    x = (x | (x << np.uint64(32))) & np.uint64(0x001F00000000FFFF)
+    x = (x | (x << np.uint64(16))) & np.uint64(0x001F0000FF0000FF)
+    x = (x | (x << np.uint64(8))) & np.uint64(0x100F00F00F00F00F)
+    x = (x | (x << np.uint64(4))) & np.uint64(0x10C30C30C30C30C3)
+    x = (x | (x << np.uint64(2))) & np.uint64(0x1249249249249249)
+    return x
+
 
 #: faces of a leaf at most
 LEAF = 4

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..elastic import vertex_pressure
+from ..contact.elastic import vertex_pressure
 from ..kernels.contact import FORCE, rotation_entries
 from ..surfaces import contact_areas, slot_normals, vertex_feet
 

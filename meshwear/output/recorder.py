@@ -8,8 +8,7 @@ import errno
 import shutil
 from pathlib import Path
 
-from ..scene import RESERVED_NAMES
-from ..wear import error_estimate
+from ..scene.format import RESERVED_NAMES
 from .fields import body_quantities, body_totals, part_quantities
 from .export import SERIES_SUFFIXES
 from .folder import SPARE_BYTES, FolderLock, check_writable
@@ -211,7 +210,7 @@ def summary(model, state, wall_time, status="ok", message=None):
         out["resolved_cycles"] = state.jump.resolved_steps * model.dt / model.period
         out["resolved_steps"] = state.jump.resolved_steps
         out["jumps"] = state.jump.jumps
-        out["error_estimate"] = error_estimate(state)
+        out["error_estimate"] = state.jump.error_estimate(state)
         out["jump_limits"] = dict(state.jump.limits)
         out["jump_method"] = model.scene.wear.jump
     if message:

@@ -5,10 +5,10 @@ states the contract) and is named in :data:`TYPES`, the scene's
 ``[[surface]] type``. docs/model.md ("Counter-surfaces") describes the model.
 """
 
-from .active import (CULL_MARGIN, CULL_POSE, CULL_SIZE, CULL_TIME, MARGIN_FRACTION,
-                     STEPS_IN_MARGIN, Cull, SurfaceSet, body_margin, contact_areas, contact_faces,
-                     initial_planes, margin_of, moved_since_refresh, needs_refresh, query,
-                     refresh, slot_normals, step_motion, update, vertex_feet)
+from .active import (CULL_MARGIN, CULL_POSE, CULL_SIZE, CULL_TIME, MARGIN_FRACTION, STEPS_IN_MARGIN,
+                     Cull, SurfaceSet, body_margin, contact_areas, contact_faces, initial_planes,
+                     margin_of, moved_since_refresh, needs_refresh, query, refresh, slot_normals,
+                     step_motion, update, vertex_feet)
 from .analytic import Cylinder, Sphere
 from .base import CounterSurface, SurfaceMotion, quaternion_matrix
 from .mesh import MeshSurface

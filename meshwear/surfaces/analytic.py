@@ -8,7 +8,7 @@ of any radius costs what a plane costs per vertex.
 import numpy as np
 
 from ..kernels.counter import CYLINDER, SPHERE
-from ..motion import _perpendicular
+from ..motion.motions import _perpendicular
 from .base import CounterSurface, SurfaceMotion, distance_to_line
 
 #: relative tolerance for "parallel" and "on the axis"

@@ -43,7 +43,7 @@ from ..kernels.frames import (BOUNDS_SIZE, CONSTANT, LEVER, NORMAL, PROJECTION, 
                               surface_frame)
 from ..kernels.contact import rotation_entries
 from ..kernels.counter_wear import NO_PART
-from ..motion import Path
+from ..motion.motions import Path
 
 
 def quaternion_matrix(q):

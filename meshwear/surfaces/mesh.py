@@ -13,7 +13,8 @@ import logging
 import fcl
 import numpy as np
 
-from .. import geometry, remesh
+from .. import geometry
+from ..geometry import meshes, remesh
 from ..kernels import tree
 from ..kernels.counter import MESH
 from ..kernels.laws import name_of as code_name
@@ -86,7 +87,7 @@ class MeshSurface(CounterSurface):
                  smooth_normals=False):
         super().__init__(name, SurfaceMotion(quaternion_matrix(orientation), position, rotation,
                                              path))
-        self.vertices, self.faces = geometry._arrays(vertices, faces)
+        self.vertices, self.faces = meshes._arrays(vertices, faces)
         self.face_normals = np.ascontiguousarray(geometry.face_normals(self.vertices, self.faces))
         self.frames = face_frames(self.vertices, self.faces)
         self.corner_normals = (corner_normals(self.vertices, self.faces, self.face_normals)

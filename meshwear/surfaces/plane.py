@@ -3,7 +3,7 @@
 import numpy as np
 
 from ..kernels.frames import plane_rows
-from ..output.vtk import plane_patch
+from ..geometry.meshes import plane_patch
 from .base import CounterSurface, SurfaceMotion
 
 

@@ -16,13 +16,15 @@ from functools import partial
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from . import elastic, stepper, surfaces
-from .geometry import inverted_faces
-from .kernels.loop import deepest_penetration, impact_check, use_impact_room
-from .kernels.rigid import TURNING
-from .model import IMPACT_DEPTH, body_contact, settle_counters, wear_counters
-from .output.memory import MemoryHistory
-from .wear import run_cycle_jump
+from ..contact import elastic
+from . import stepper
+from .. import surfaces
+from ..geometry.properties import inverted_faces
+from ..kernels.loop import deepest_penetration, impact_check, use_impact_room
+from ..kernels.rigid import TURNING
+from ..model.build import IMPACT_DEPTH, body_contact, settle_counters, wear_counters
+from ..output.memory import MemoryHistory
+from ..longrun.wear import run_cycle_jump
 
 
 #: steps between two progress reports at most
@@ -308,8 +310,8 @@ def run_scene(scene, observers=(), check_dt=True):
     -------
     model, state, history : Model, State, MemoryHistory
     """
-    from .model import build_model, check_time_step, initial_state
-    from .scene import Scene, load_scene
+    from ..model.build import build_model, check_time_step, initial_state
+    from ..scene.format import Scene, load_scene
 
     if not isinstance(scene, Scene):
         scene = load_scene(scene)

@@ -23,12 +23,11 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .geometry import STEP_FORMATS
-from .kernels.laws import LAWS
-from .scene_checks import (SceneError, _boolean, _choice, _coefficient, _did_you_mean,
-                           _direction, _exclusive, _instance, _integer, _length, _name,
-                           _nonnegative, _place, _positive, _real, _set, _set_optional, _show,
-                           _vector, winkler_stiffness)
+from ..geometry.meshes import STEP_FORMATS
+from ..kernels.laws import LAWS
+from .checks import (SceneError, _boolean, _choice, _coefficient, _did_you_mean, _direction,
+                     _exclusive, _instance, _integer, _length, _name, _nonnegative, _place,
+                     _positive, _real, _set, _set_optional, _show, _vector, winkler_stiffness)
 
 FORMAT = 1
 MODES = ("dynamic", "quasi-static")

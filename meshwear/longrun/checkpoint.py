@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .kernels.rigid import SETTLED, TURNING
-from .output.tables import replace_atomic
-from .scene import SceneError
+from ..kernels.rigid import SETTLED, TURNING
+from ..output.tables import replace_atomic
+from ..scene.format import SceneError
 
 FILE_NAME = "checkpoint.npz"
 _BODY_ARRAYS = ("pose", "vertices", "wear_depth", "friction_work", "wear_volume",

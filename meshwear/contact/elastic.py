@@ -53,13 +53,13 @@ from threadpoolctl import threadpool_limits
 
 from . import halfspace
 from .cellfields import bilinear, signed_to_vertices, to_vertices
-from .kernels.contact import FORCE as FORCE_SLOT
-from .kernels.contact import NO_CONTACT, SLIP, STICK
-from .kernels.elastic import gaps
-from .kernels.laws import LAWS, name_of
-from .kernels.rigid import OSCILLATION, STEADY
-from .motion import BalancedMotion, _perpendicular
-from .surfaces.base import quaternion_matrix
+from ..kernels.contact import FORCE as FORCE_SLOT
+from ..kernels.contact import NO_CONTACT, SLIP, STICK
+from ..kernels.elastic import gaps
+from ..kernels.laws import LAWS, name_of
+from ..kernels.rigid import OSCILLATION, STEADY
+from ..motion.motions import BalancedMotion, _perpendicular
+from ..surfaces.base import quaternion_matrix
 
 #: the normal problem is solved again when the gaps changed (rigid moves
 #: aside) by more than this fraction of the elastic approach

@@ -12,20 +12,21 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import geometry, reach, remesh, surfaces
-from .surfaces.margin import contact_margin
-from .dynamics import OwnMotions
-from .elastic import HalfSpace, PatchError
-from .elastic import step as elastic_step
-from .kernels.contact import LAW_SLOTS, all_vertices, contact, make_law, rotation_entries
-from .kernels.counter_wear import settle_counter, wear_counter
-from .kernels.laws import code_of
-from .kernels.nearest import face_frames
-from .motion import (BalancedMotion, FixedMotion, FreeMotion, GuidedMotion, MechanismMotion, Path,
-                     TurningMotion,
-                     PrescribedMotion)
-from .scene import SceneError
-from .stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_stiffness
+from .. import geometry, surfaces
+from . import reach
+from ..geometry import remesh
+from ..surfaces.margin import contact_margin
+from ..motion.dynamics import OwnMotions
+from ..contact.elastic import HalfSpace, PatchError
+from ..contact.elastic import step as elastic_step
+from ..kernels.contact import LAW_SLOTS, all_vertices, contact, make_law, rotation_entries
+from ..kernels.counter_wear import settle_counter, wear_counter
+from ..kernels.laws import code_of
+from ..kernels.nearest import face_frames
+from ..motion.motions import (BalancedMotion, FixedMotion, FreeMotion, GuidedMotion,
+                              MechanismMotion, Path, TurningMotion, PrescribedMotion)
+from ..scene.format import SceneError
+from ..contact.stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_stiffness
 
 #: meshwear's own motions, the dynamics of a model without a mechanism
 OWN_MOTIONS = OwnMotions()
@@ -332,7 +333,7 @@ def build_model(scene):
     _timing(scene, scene.wear.period or (max(periods) if periods else None), math.inf)
     mechanism = None
     if scene.mechanism is not None:
-        from .mechanism import Mechanism
+        from ..mechanism.build import Mechanism
 
         mechanism = Mechanism(scene)
     built = []
@@ -476,7 +477,7 @@ def _ride(mechanism, surface, index, name, t):
     """Put counter-surface ``surface`` on mechanism body ``name``: its rest
     frame becomes its placement in that body's frame, its motion a steady
     turn and velocity rewritten at every step (:mod:`meshwear.mechanism`)."""
-    from .kernels.rigid import STEADY
+    from ..kernels.rigid import STEADY
 
     m = surface.motion
     if not getattr(surface, "rider", False):

@@ -50,13 +50,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import jump_geometry, jumps
-from .kernels.contact import ANCHOR
-from .kernels.counter_wear import SPACING_FRACTION
-from .kernels.nearest import face_frames
-from .kernels.rigid import SETTLED
-from .motion import TurningMotion
-from .output import filled
-from .surfaces import contact_areas, quaternion_matrix, slot_normals
+from ..kernels.contact import ANCHOR
+from ..kernels.counter_wear import SPACING_FRACTION
+from ..kernels.nearest import face_frames
+from ..kernels.rigid import SETTLED
+from ..motion.motions import TurningMotion
+from ..output import filled
+from ..surfaces import contact_areas, quaternion_matrix, slot_normals
 
 #: largest wear in one explicit jump, as a fraction of a vertex's elastic penetration
 THETA = 0.3
@@ -85,7 +85,10 @@ HISTORY = 8
 
 @dataclass
 class JumpState:
-    """The controller's memory, saved with checkpoints."""
+    """The controller's memory, saved with checkpoints.
+
+    The outputs, a stage below the long run, read its error through
+    :meth:`error_estimate` and import nothing of this module."""
 
     rate: list = field(default_factory=list)       # per body (n,) wear per cycle, last measured
     gap: float = 0.0                                # cycles between the last two measurements
@@ -142,6 +145,10 @@ class JumpState:
                                                     # measurements (at most HISTORY), each
                                                     # (middle, cycles; (V,) depth then, m;
                                                     # rate, m per cycle; stiffness, per cycle)
+
+    def error_estimate(self, state):
+        """:func:`error_estimate` of ``state``, whose controller this is."""
+        return error_estimate(state)
 
 
 def penetration(model, body, s):

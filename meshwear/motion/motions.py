@@ -23,13 +23,13 @@ turns it to where its contacts carry the torque.
 
 import numpy as np
 
-from .kernels.balance import balance_offset
-from .kernels.rigid import (ACCELERATION, AXIS, BALANCED, CARRIED, CIRCLE, FIXED, FREE, GUIDED,
-                            INERTIA, INVERSE_INERTIA, INVERSE_MASS, MOTION_PARAMS, OSCILLATION,
-                            ORIENTATION, PRESCRIBED, SETTLED, START, STEADY, TURN_AXIS,
-                            TURN_CENTER, TURN_RATE, TURNING, advance_free_motion, advance_motion,
-                            path_point, place_motion)
-from .kernels.turn_balance import place_settled, settle_turn
+from ..kernels.balance import balance_offset
+from ..kernels.rigid import (ACCELERATION, AXIS, BALANCED, CARRIED, CIRCLE, FIXED, FREE, GUIDED,
+                             INERTIA, INVERSE_INERTIA, INVERSE_MASS, MOTION_PARAMS, OSCILLATION,
+                             ORIENTATION, PRESCRIBED, SETTLED, START, STEADY, TURN_AXIS,
+                             TURN_CENTER, TURN_RATE, TURNING, advance_free_motion, advance_motion,
+                             path_point, place_motion)
+from ..kernels.turn_balance import place_settled, settle_turn
 
 
 class Path:
@@ -275,7 +275,7 @@ class TurningMotion(Motion):
     def lever(self, vertices, pose):
         """The largest lever (m) of ``vertices`` (n, 3, body frame) about
         the turn's axis, the body at ``pose``."""
-        from .kernels.contact import rotation_entries
+        from ..kernels.contact import rotation_entries
 
         R = np.array(rotation_entries(np.asarray(pose[3:7], float))).reshape(3, 3)
         x = pose[0:3] + vertices @ R.T

@@ -28,14 +28,14 @@ import logging
 
 import numpy as np
 
-from .kernels.loop import DONE, REFRESH, loop_for
-from .kernels.mechanism import (mechanism_loop, needs_refresh as _needs_refresh, place_body,
-                                place_surface, push_body, push_reaction,
-                                slot_wrench as _slot_wrench)
-from .packing import body_arrays, motion_arrays
-from .scene import SceneError
-from .stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_stiffness
-from .surfaces.base import quaternion_matrix
+from ..kernels.loop import DONE, REFRESH, loop_for
+from ..kernels.mechanism import (mechanism_loop, needs_refresh as _needs_refresh, place_body,
+                                 place_surface, push_body, push_reaction,
+                                 slot_wrench as _slot_wrench)
+from ..motion.packing import body_arrays, motion_arrays
+from ..scene.format import SceneError
+from ..contact.stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_stiffness
+from ..surfaces.base import quaternion_matrix
 
 
 #: the bodies' active sets on a mechanism are on trial in windows of at least
@@ -461,14 +461,14 @@ class Mechanism:
         (:func:`meshwear.kernels.mechanism.advance_mechanism`), or a step at
         a time through Python where MuJoCo's library cannot be called from
         it. Returns None, or ``(step, code, body, report)``."""
-        from .dynamics import UNSTABLE
+        from ..motion.dynamics import UNSTABLE
 
         if self.calls is None:
             for k in range(state.step, until):
                 if not self.step(model, state, k, lambda k: step_bodies(k, k + 1)):
                     return k, UNSTABLE, -1, None
             return None
-        from .surfaces import update
+        from ..surfaces import update
 
         surfaces = model.surfaces
         report = np.zeros(2, np.int64)

@@ -14,15 +14,15 @@ loop (:mod:`meshwear.mechanism`).
 
 import numpy as np
 
-from .kernels import loop
-from .packing import body_arrays as _body_arrays, motion_arrays as _motion_arrays
+from ..kernels import loop
+from ..motion.packing import body_arrays as _body_arrays, motion_arrays as _motion_arrays
 
 
 def advance(model, state, until):
     """Step every body of ``state`` from ``state.step`` to step ``until``,
     moved by the model's dynamics (:mod:`meshwear.dynamics`: meshwear's own
     motions, or a MuJoCo mechanism)."""
-    from .dynamics import UNSTABLE
+    from ..motion.dynamics import UNSTABLE
     from .simulate import NumericalError, step
 
     if model.elastic is not None:

@@ -24,8 +24,8 @@ fold
 
 import numpy as np
 
-from .surfaces import CULL_MARGIN, moved_since_refresh, quaternion_matrix
-from .surfaces.active import query_reach
+from ..surfaces import CULL_MARGIN, moved_since_refresh, quaternion_matrix
+from ..surfaces.active import query_reach
 
 #: a jump takes a face at most this fraction of the way to folding over:
 #: its displacements, over this fraction, fold none (a vertex at the rim of

@@ -10,10 +10,11 @@ would fill the memory (docs/outputs.md, "Limits checked before any work").
 
 import numpy as np
 
-from . import geometry, remesh, surfaces
-from .kernels.contact import rotation_entries
-from .motion import Path
-from .surfaces.base import quaternion_matrix
+from .. import geometry, surfaces
+from ..geometry import meshes, remesh
+from ..kernels.contact import rotation_entries
+from ..motion.motions import Path
+from ..surfaces.base import quaternion_matrix
 
 #: a face of a body that is not free can come into contact where it faces a
 #: surface within this fraction of the body's bounding-box diagonal
@@ -291,7 +292,7 @@ def _drawn_cloud(vertices, faces, spacing, snap, M, c, low, high, reach):
     ``spacing`` (m) and the reach left once the refined vertex near it
     has moved by ``snap`` (``room``, m)."""
     per = max(1, FACE_POINTS // len(c))
-    areas = 0.5 * geometry._doubled_areas(vertices, faces)
+    areas = 0.5 * meshes._doubled_areas(vertices, faces)
     total = float(areas.sum())
     empty = np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0)
     if not (total > 0.0 and reach > snap):

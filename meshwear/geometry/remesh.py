@@ -9,9 +9,8 @@ reads a model.
 
 import numpy as np
 
-from . import geometry
-from .geometry import (MeshError, _arrays, _doubled_areas, _edge_keys, _edge_lengths,
-                       spatial_order)
+from .. import geometry
+from .meshes import MeshError, _arrays, _doubled_areas, _edge_keys, _edge_lengths, spatial_order
 
 #: area of the largest triangle whose edges are all <= 1 (equilateral)
 _LARGEST_UNIT_TRIANGLE = np.sqrt(3.0) / 4.0
@@ -439,7 +438,7 @@ def spacing_notices(model, state):
     """One line per body and mesh surface whose edge lengths where they
     touch differ by :data:`SPACING_RATIO` or more."""
     # (surfaces import this module: the rotation from the kernels)
-    from .kernels.contact import rotation_entries
+    from ..kernels.contact import rotation_entries
 
     lines = []
     for body, s in zip(model.bodies, state.bodies):

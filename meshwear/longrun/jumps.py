@@ -42,11 +42,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .elastic import equivalent_depth
-from .kernels.balance import implicit_step
-from .kernels.contact import FACING
-from .motion import BalancedMotion, GuidedMotion, MechanismMotion, TurningMotion
-from .surfaces import quaternion_matrix, vertex_feet
+from ..contact.elastic import equivalent_depth
+from ..kernels.balance import implicit_step
+from ..kernels.contact import FACING
+from ..motion.motions import BalancedMotion, GuidedMotion, MechanismMotion, TurningMotion
+from ..surfaces import quaternion_matrix, vertex_feet
 
 
 def contact_geometry(model, body, s, index):

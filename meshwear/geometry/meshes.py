@@ -1,5 +1,6 @@
-"""Meshes in, plain arrays out: loading, units, cleaning, primitives, refinement,
-vertex areas, normals and mass properties.
+"""Meshes in, plain arrays out: loading, units, cleaning, primitives and face
+normals (areas, vertex normals and mass properties: :mod:`.properties`;
+refinement: :mod:`.remesh`).
 
 trimesh is used here for reading files and building primitives only; every
 function returns plain arrays, ``vertices : (n, 3) float64`` (C-contiguous) and
@@ -11,6 +12,8 @@ import logging
 from pathlib import Path
 
 import numpy as np
+
+from ..kernels.tree import morton_codes
 
 log = logging.getLogger(__name__)
 
@@ -374,17 +377,6 @@ def _remove_slivers(vertices, faces, passes=16):
 
 # ------------------------------------------------------------- space order
 
-def morton_codes(points):
-    """(n,) uint64 Morton codes of ``points`` (n, 3): 20 bits an axis, one
-    scale for the three (so that the curve keeps distances)."""
-    if len(points) == 0:
-        return np.zeros(0, np.uint64)
-    low = points.min(axis=0)
-    span = float((points.max(axis=0) - low).max())
-    q = np.floor((points - low) / (span if span > 0.0 else 1.0) * 1048575.0).astype(np.uint64)
-    return _spread(q[:, 0]) | (_spread(q[:, 1]) << np.uint64(1)) | (_spread(q[:, 2]) << np.uint64(2))
-
-
 def spatial_order(vertices, faces):
     """The same mesh with its vertices and its faces each sorted along a
     Morton curve (vertices near in space near in memory: a query walking
@@ -399,17 +391,6 @@ def spatial_order(vertices, faces):
     tri = vertices[faces]
     by_face = np.argsort(morton_codes(0.5 * (tri.min(axis=1) + tri.max(axis=1))), kind="stable")
     return np.ascontiguousarray(vertices), np.ascontiguousarray(faces[by_face]), by_face
-
-
-def _spread(x):
-    """The 20 low bits of each uint64 spread to every third bit."""
-    x = x & np.uint64(0xFFFFF)
-    x = (x | (x << np.uint64(32))) & np.uint64(0x001F00000000FFFF)
-    x = (x | (x << np.uint64(16))) & np.uint64(0x001F0000FF0000FF)
-    x = (x | (x << np.uint64(8))) & np.uint64(0x100F00F00F00F00F)
-    x = (x | (x << np.uint64(4))) & np.uint64(0x10C30C30C30C30C3)
-    x = (x | (x << np.uint64(2))) & np.uint64(0x1249249249249249)
-    return x
 
 
 # ------------------------------------------------------------- primitives
@@ -523,34 +504,6 @@ def _edge_keys(F, n):
     G = np.roll(F, -1, axis=1)
     return (np.minimum(F, G) * n + np.maximum(F, G)).ravel()
 
-
-# ------------------------------------------------- areas, normals, checks
-
-def tributary_areas(vertices, faces):
-    """(n,) float: each vertex's barycentric share (m²), a third of each adjacent face's area."""
-    V, F = _arrays(vertices, faces)
-    third = _doubled_areas(V, F) / 6.0
-    return np.bincount(F.ravel(), weights=np.repeat(third, 3), minlength=len(V))
-
-
-def area_vectors(vertices, faces):
-    """(n, 4) float: each vertex's area vector (m²): a third of each adjacent
-    face's area times its outward unit normal, summed; then its length.
-
-    Projected on a direction ``-n``, the vector gives the vertex's share of
-    the surface's projection on a plane of normal ``n``: its contact area
-    there. Its length is at most the tributary area.
-    """
-    V, F = _arrays(vertices, faces)
-    tri = V[F]
-    third = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]) / 6.0   # area/3 · normal
-    out = np.zeros((len(V), 4))
-    for k in range(3):
-        out[:, k] = np.bincount(F.ravel(), weights=np.repeat(third[:, k], 3), minlength=len(V))
-    out[:, 3] = np.linalg.norm(out[:, 0:3], axis=1)
-    return out
-
-
 def face_normals(vertices, faces):
     """(m, 3) float: unit outward face normals; zero-area faces give zeros."""
     V, F = _arrays(vertices, faces)
@@ -560,129 +513,47 @@ def face_normals(vertices, faces):
     return np.divide(cross, norm, out=np.zeros_like(cross), where=norm > 0.0)
 
 
-def vertex_normals(vertices, faces):
-    """(n, 3) float: unit outward vertex normals, area-weighted over adjacent faces."""
-    V, F = _arrays(vertices, faces)
-    tri = V[F]
-    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])   # 2 · area · normal
-    summed = np.zeros_like(V)
-    for k in range(3):
-        np.add.at(summed, F[:, k], cross)
-    norm = np.linalg.norm(summed, axis=1, keepdims=True)
-    return np.ascontiguousarray(np.divide(summed, norm, out=np.zeros_like(summed), where=norm > 0.0))
-
-
-def inverted_faces(reference_normals, vertices, faces, reference_areas=None):
-    """(k,) int: faces whose current normal flipped or collapsed against the reference.
-
-    A face is flagged when its area projected on its reference normal is
-    negative (flipped) or below 1e-12 of its reference area (collapsed). Without
-    ``reference_areas`` the collapse test is relative to the face's longest
-    edge squared. Faces with a zero reference normal are never flagged.
+def plane_patch(point, normal, size, divisions=1):
+    """A square patch of a plane, centred at ``point``, for drawing an analytic plane.
 
     Parameters
     ----------
-    reference_normals : (m, 3) float
-        Unit normals of the unworn faces (:func:`face_normals`).
-    vertices : (n, 3) float
-        Current (worn) vertices, same frame as the reference.
-    faces : (m, 3) int
-    reference_areas : (m,) float, optional
-    """
-    V, F = _arrays(vertices, faces)
-    ref = np.asarray(reference_normals, np.float64)
-    tri = V[F]
-    projected = 0.5 * np.einsum("ij,ij->i", np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), ref)
-    if reference_areas is not None:
-        scale = np.asarray(reference_areas, np.float64)
-    else:
-        scale = _edge_lengths(V, F).max(axis=1) ** 2
-    valid = np.einsum("ij,ij->i", ref, ref) > 0.0
-    return np.flatnonzero(valid & (projected <= 1e-12 * scale))
-
-
-# ---------------------------------------------------------- mass, info
-
-def mass_properties(vertices, faces, density=None, mass=None, source="mesh"):
-    """Mass, centre of mass and inertia of the solid a closed mesh encloses.
-
-    Exact polyhedral integrals (trimesh), evaluated about the bounding-box
-    centre to keep precision for meshes far from their origin. A closed mesh
-    with inverted winding (negative volume) is accepted as if flipped.
-
-    Parameters
-    ----------
-    vertices : (n, 3) float
-    faces : (m, 3) int
-    density : float, optional
-        kg/m³.
-    mass : float, optional
-        kg, instead of density (the inertia is scaled to it). Neither: density 1.
-    source : str
-        Named in errors.
+    point : (3,) float
+        Centre (m).
+    normal : (3,) float
+        Plane normal (need not be unit); the faces are wound so their normal is +normal.
+    size : float or (2,) float
+        Side length(s) (m).
+    divisions : int
+        Cells per side; the patch has 2·divisions² triangles.
 
     Returns
     -------
-    mass : float
-        kg.
-    center_of_mass : (3,) float
-        In the mesh frame (m).
-    inertia : (3, 3) float
-        About the centre of mass, mesh axes (kg·m²).
+    vertices : (n, 3) float
+    faces : (m, 3) int
     """
-    import trimesh
-
-    if density is not None and mass is not None:
-        raise ValueError("give density or mass, not both")
-    for name, value in (("density", density), ("mass", mass)):
-        if value is not None and not (np.isfinite(value) and value > 0):
-            raise ValueError(f"{name} must be positive, got {value!r}")
-    V, F = _arrays(vertices, faces)
-    mesh = trimesh.Trimesh(V, F, process=False)
-    if not mesh.is_watertight:
-        raise MeshError(f"{source}: open mesh ({_boundary_edges(F)} boundary edges): "
-                        "give the body a closed mesh")
-    if not mesh.is_winding_consistent:
-        raise MeshError(f"{source}: inconsistent face winding: give the body a consistently oriented closed mesh")
-    shift = 0.5 * (V.min(axis=0) + V.max(axis=0))
-    props = trimesh.triangles.mass_properties(V[F] - shift, density=1.0)
-    volume = float(props.volume)
-    if volume < 0.0:
-        log.warning("%s: faces wound inwards (negative volume); using the flipped mesh", source)
-        props = trimesh.triangles.mass_properties(V[F[:, ::-1]] - shift, density=1.0)
-        volume = float(props.volume)
-    if not volume > 0.0:
-        raise MeshError(f"{source}: the mesh encloses no volume")
-    rho = (mass / volume) if mass is not None else (1.0 if density is None else float(density))
-    inertia = np.ascontiguousarray(props.inertia * rho)
-    return rho * volume, np.asarray(props.center_mass, np.float64) + shift, inertia
-
-
-def _boundary_edges(F):
-    _, count = np.unique(_edge_keys(F, int(F.max()) + 1), return_counts=True)
-    return int((count != 2).sum())
-
-
-def mesh_info(path, units="m"):
-    """Summary of a mesh file after loading and cleaning (plain Python values, SI).
-
-    Returns
-    -------
-    dict
-        ``vertices``, ``faces``, ``watertight``, ``extents`` [3], ``area`` (m²),
-        ``volume`` (m³, None if open), ``bounds`` [[min], [max]].
-    """
-    import trimesh
-
-    V, F = load_mesh(path, units)
-    mesh = trimesh.Trimesh(V, F, process=False)
-    watertight = bool(mesh.is_watertight and mesh.is_winding_consistent)
-    return {
-        "vertices": len(V),
-        "faces": len(F),
-        "watertight": watertight,
-        "extents": np.ptp(V, axis=0).tolist(),
-        "area": float(_doubled_areas(V, F).sum() / 2.0),
-        "volume": abs(float(mesh.volume)) if watertight else None,
-        "bounds": [V.min(axis=0).tolist(), V.max(axis=0).tolist()],
-    }
+    point = np.asarray(point, np.float64).reshape(3)
+    normal = np.asarray(normal, np.float64).reshape(3)
+    length = np.linalg.norm(normal)
+    if not length > 0:
+        raise ValueError(f"normal {normal.tolist()} has zero length")
+    normal = normal / length
+    width, height = np.broadcast_to(np.asarray(size, np.float64), 2)
+    if not (width > 0 and height > 0):
+        raise ValueError(f"size {size!r} must be positive")
+    divisions = int(divisions)
+    if divisions < 1:
+        raise ValueError(f"divisions must be >= 1, got {divisions}")
+    # in-plane axes u, v with u x v = normal; u from the world axis least aligned with the normal
+    u = np.cross(normal, np.eye(3)[np.argmin(np.abs(normal))])
+    u /= np.linalg.norm(u)
+    v = np.cross(normal, u)
+    s = np.linspace(-0.5, 0.5, divisions + 1)
+    su, sv = np.meshgrid(s * width, s * height, indexing="ij")
+    vertices = point + su.reshape(-1, 1) * u + sv.reshape(-1, 1) * v
+    i, j = np.meshgrid(np.arange(divisions), np.arange(divisions), indexing="ij")
+    p00 = (i * (divisions + 1) + j).ravel()
+    p10, p01 = p00 + divisions + 1, p00 + 1
+    p11 = p10 + 1
+    faces = np.concatenate([np.stack([p00, p10, p11], axis=1), np.stack([p00, p11, p01], axis=1)])
+    return np.ascontiguousarray(vertices), np.ascontiguousarray(faces, dtype=np.int64)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import stepper
-from .model import initial_state
+from ..model.build import initial_state
 
 #: steps timed for the per-step cost at least, and the wall time (s) after
 #: which the trial stops sooner (steps of seconds: a fine worn mesh)
@@ -178,7 +178,7 @@ def _writing(model, state):
     """Seconds to set up the outputs and write every frame and history row
     of ``model``: the first of each timed (the writers' imports and set-up,
     which the run pays too), then one of each again."""
-    from .output.recorder import RunRecorder
+    from ..output.recorder import RunRecorder
 
     frames, samples = len(model.frame_steps), len(model.sample_steps)
     with tempfile.TemporaryDirectory() as out:
@@ -274,7 +274,7 @@ def _cycles_left(position, total, window, settle, jump, trend):
     (``GROWTH J + 1`` from the last ``jump``, up to ``trend``'s ``a p^b``,
     at least one cycle; None: growth alone, "none": no jump) that leaves
     the run's last cycle resolved, and ``settle`` cycles after it."""
-    from .wear import GROWTH
+    from ..longrun.wear import GROWTH
 
     cycles = 0.0
     if trend == "none":
@@ -385,7 +385,7 @@ def _jumping(model, resolved, deadline=None, per_step=0.0):
     remaining outputs filled from jumps at the trial's cost per filled
     output (the writing itself is :func:`_writing`'s). Never more than
     ``resolved``."""
-    from .jumps import compile_kernels
+    from ..longrun.jumps import compile_kernels
     from .simulate import PROGRESS_STEPS, run
 
     if model.scene.wear.jump == "implicit":

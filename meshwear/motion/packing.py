@@ -3,7 +3,7 @@
 
 import numpy as np
 
-from .kernels.rigid import BALANCED, TURNING
+from ..kernels.rigid import BALANCED, TURNING
 
 
 def body_arrays(model, body, s):

@@ -1,0 +1,9 @@
+"""Contact models: how a vertex presses on a counter-surface (docs/model.md).
+
+- the Winkler (penalty) contact is compiled: :mod:`meshwear.kernels.contact`;
+- :mod:`.elastic`: the elastic half-space model in a run, on the solver of
+  :mod:`.halfspace` and the grid fields of :mod:`.cellfields`;
+- :mod:`.stability`: the contact's bound on a stable time step.
+
+Imports the stages below it (surfaces, motion, geometry, kernels).
+"""

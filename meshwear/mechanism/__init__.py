@@ -1,0 +1,8 @@
+"""Mechanisms: worn parts riding on the bodies of a MuJoCo model (docs/mechanisms.md).
+
+Imports the stages below it (scene, motion, surfaces, contact, kernels).
+"""
+
+from .build import (Mechanism, slot_wrench)
+
+__all__ = ["Mechanism", "slot_wrench"]
