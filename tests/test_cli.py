@@ -587,7 +587,7 @@ def test_non_finite_state_stops_with_exit_3(tmp_path, capsys, caplog, monkeypatc
     it stay valid."""
     import meshwear.step.stepper
 
-    real_advance = meshwear.stepper.advance
+    real_advance = meshwear.step.stepper.advance
 
     def advance(model, state, until):
         before = state.step
@@ -595,7 +595,7 @@ def test_non_finite_state_stops_with_exit_3(tmp_path, capsys, caplog, monkeypatc
         if before < 400 <= state.step:
             state.bodies[0].pose[7] = float("nan")
 
-    monkeypatch.setattr(meshwear.stepper, "advance", advance)
+    monkeypatch.setattr(meshwear.step.stepper, "advance", advance)
     scene = write(tmp_path / "scene.toml", BASE)
     out_dir = tmp_path / "out"
     code, out, err = cli(capsys, caplog, "run", scene, "-o", out_dir, "-q")

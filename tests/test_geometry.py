@@ -149,8 +149,8 @@ def test_a_mesh_file_is_read_once_per_model(monkeypatch):
     from meshwear.scene.format import load_scene
 
     reads = []
-    load = geometry.load_mesh
-    monkeypatch.setattr(geometry, "load_mesh", lambda *a, **k: reads.append(a) or load(*a, **k))
+    load = meshes.load_mesh
+    monkeypatch.setattr(meshes, "load_mesh", lambda *a, **k: reads.append(a) or load(*a, **k))
     scene = load_scene("examples/gear_pair.toml", (("body[0].resolution", 2e-3),))
     build_model(scene)
     assert len(reads) == 1, reads

@@ -1,5 +1,5 @@
 """A cycle jump never folds the mesh it moves (docs/model.md, "Long durations":
-the bounds ``reach`` and ``fold``, :mod:`meshwear.jump_geometry`)."""
+the bounds ``reach`` and ``fold``, :mod:`meshwear.longrun.jump_geometry`)."""
 
 import numpy as np
 import pytest
@@ -120,7 +120,7 @@ def _ball(subdivisions=2):
 
 
 class _Body:
-    """What :func:`meshwear.jump_geometry.fold_room` reads of a body."""
+    """What :func:`meshwear.longrun.jump_geometry.fold_room` reads of a body."""
 
     def __init__(self, faces, normals):
         self.faces, self.reference_face_normals = faces, normals
@@ -171,9 +171,9 @@ def test_fold_room_of_a_vertex_pushed_through_its_neighbours():
 
 
 def test_a_jump_is_cut_to_the_share_its_mesh_allows():
-    """:func:`meshwear.jump_geometry.cut` on a jump of an icosahedron whose
+    """:func:`meshwear.longrun.jump_geometry.cut` on a jump of an icosahedron whose
     vertex wore inwards in the measured cycle: its fold bound is
-    :data:`meshwear.jump_geometry.FOLD` of the room the jump's moves leave,
+    :data:`meshwear.longrun.jump_geometry.FOLD` of the room the jump's moves leave,
     and a move of the body along its axis past the reach of the vertices
     measured is cut to the reach, whichever is shorter."""
     from types import SimpleNamespace

@@ -879,7 +879,7 @@ def test_a_worn_surface_is_refined_only_where_a_body_reaches_it(tmp_path):
 def test_the_early_refusal_counts_only_surface_the_refined_bodies_reach(stem, share):
     """Before any part is refined, a worn surface's resolution is refused
     from the surface within a lower bound of the reach of the bodies' sweep
-    (meshwear.reach.refuse_early): that of their vertices as given, and of
+    (meshwear.model.reach.refuse_early): that of their vertices as given, and of
     points drawn on the faces their resolution refines, allowing for how
     far the refined vertices may lie from those points. Every point of the
     surface it counts is one the refined bodies' sweep reaches

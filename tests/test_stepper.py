@@ -1,5 +1,5 @@
 """The compiled step loop (meshwear/kernels/loop.py) against the Python step
-it replaces (meshwear.simulate.step): the same numbers to the last bit, on
+it replaces (meshwear.step.simulate.step): the same numbers to the last bit, on
 every kind of motion and surface, with active-set refreshes on the way."""
 
 import dataclasses
@@ -135,7 +135,7 @@ def test_the_compiled_loop_gives_the_python_step_s_numbers_bit_for_bit(tmp_path,
             model = build_model(scene)
             state = initial_state(model)
             for s in state.bodies:
-                # the sums a measured cycle keeps (meshwear.jumps.LOAD_ROWS)
+                # the sums a measured cycle keeps (meshwear.longrun.jumps.LOAD_ROWS)
                 s.load = np.zeros((LOAD_ROWS, len(s.wear_depth)))
             state = run(model, state, compiled=compiled)
             monkeypatch.undo()
