@@ -144,6 +144,41 @@ def step(model, body, s, t, before, at_rest=False):
                          "the half-space model balances the load along the normal (give "
                          "free_axis along it)")
     load = motion.carried / beta if balanced else None
+    take, heights, shift_move = _solve_normal(body, s, t, patch, active, gap, n, area, r, hmin,
+                                              balanced, load)
+    # from here on, the vertices that carry load only
+    on = patch.loaded
+    idx = patch.index[on]
+    F = patch.forces[on]
+    at = take[on]
+    approach = patch.approach + shift_move
+    velocity = velocity[at]
+    if balanced:
+        # the load balance: the body approaches by the solve's approach
+        z = -approach / beta
+        s.pose[0:3] += z * motion.axis
+        if not at_rest:
+            s.pose[7:10] = (s.pose[0:3] - before) / model.dt
+            velocity += (z / model.dt) * motion.axis
+    k_area = area[at]
+    normal_world = n[at]
+    slip_v = velocity - np.einsum("ij,ij->i", velocity, normal_world)[:, None] * normal_world
+    energy, friction, state = _tangential(model, patch, F, slip_v, elastic.friction, at_rest)
+    _wear(model, body, s, patch, idx, F, energy, slip_v, k_area, normal_world)
+    _record(s, patch, idx, F, friction, state, normal_world, r, at)
+    _foundation(model, patch, approach, heights, on, k_area, F)
+
+
+def _solve_normal(body, s, t, patch, active, gap, n, area, r, hmin, balanced, load):
+    """Step 3 of :func:`step`: the normal problem on a patch that fits it.
+    The patch's grid is kept while the vertices' tangent coordinates hold
+    (else built again over the band of gaps ``gap`` above ``hmin``); the
+    solve is skipped while the gaps moved rigidly (within :data:`RESOLVE`),
+    else taken (``load`` for a guided body, ``balanced``; the overlap for
+    the others) and the band grown or shrunk, the grid built again, until
+    the contact lies inside it. Returns the patch's vertices' positions in
+    ``active``, their gaps, and the rigid move along the normal the
+    approach follows (m; 0 after a solve)."""
     shift_move = 0.0
     for _ in range(8):
         take = None if patch.grid is None else _locate(patch, active, r)
@@ -204,26 +239,17 @@ def step(model, body, s, t, before, at_rest=False):
     else:
         raise PatchError(f"body {body.name!r}: the half-space patch did not settle at "
                          f"t = {t:.6g} s")
-    # from here on, the vertices that carry load only
-    on = patch.loaded
-    idx = patch.index[on]
-    F = patch.forces[on]
-    at = take[on]
-    approach = patch.approach + shift_move
-    velocity = velocity[at]
-    if balanced:
-        # the load balance: the body approaches by the solve's approach
-        z = -approach / beta
-        s.pose[0:3] += z * motion.axis
-        if not at_rest:
-            s.pose[7:10] = (s.pose[0:3] - before) / model.dt
-            velocity += (z / model.dt) * motion.axis
-    k_area = area[at]
-    normal_world = n[at]
-    slip_v = velocity - np.einsum("ij,ij->i", velocity, normal_world)[:, None] * normal_world
-    energy, friction, state = _tangential(model, patch, F, slip_v, elastic.friction, at_rest)
+    return take, heights, shift_move
+
+
+def _wear(model, body, s, patch, idx, F, energy, slip_v, k_area, normal_world):
+    """Step 5 of :func:`step`: the loaded vertices ``idx`` (forces ``F``,
+    friction ``energy``, slip velocities ``slip_v``, contact areas
+    ``k_area``, contact normals ``normal_world``) wear by the wear law and
+    add up their friction work; and what a worn counter wears by
+    (``patch.counter``)."""
     # wear: the law on each vertex's energy, load and slip
-    mu = elastic.friction
+    mu = model.elastic.friction
     law = LAWS[name_of(int(model.law[2]))]
     slip_distance = energy / (mu * F) if mu > 0.0 else np.zeros(len(F))
     dw, dv = law.twin(model.law[3], energy, F, slip_distance, np.where(k_area > 0.0, k_area, 1.0))
@@ -243,6 +269,13 @@ def step(model, body, s, t, before, at_rest=False):
     speed = np.linalg.norm(slip_v, axis=1)
     moving = (energy > 0.0) & (speed > 0.0) & (mu > 0.0)
     patch.counter = (idx[moving], energy[moving] / (mu * speed[moving] * model.dt))
+
+
+def _record(s, patch, idx, F, friction, state, normal_world, r, at):
+    """The step's contacts written into the state ``s`` as the Winkler
+    kernel writes them: each loaded vertex's normal force, friction and
+    contact state, the body's wrench (``r[at]``: their offsets from the
+    body's origin), the load history."""
     s.normal_force[0, idx] = F
     s.tangential[0, idx, FORCE_SLOT] = friction
     s.contact_state[0, idx] = state
@@ -255,6 +288,13 @@ def step(model, body, s, t, before, at_rest=False):
         s.load[1, idx] += F * F
         if len(s.load) > 2:
             s.load[2:5, idx] += (F[:, None] * normal_world).T
+
+
+def _foundation(model, patch, approach, heights, on, k_area, F):
+    """Once, at the first contact with an overlap: the stiffness per area
+    of the Winkler foundation equivalent to it (``model.law``), from the
+    loaded vertices' (``on``, of the patch's) overlaps ``approach -
+    heights``."""
     if not patch.extra.get("foundation"):
         # the Winkler foundation equivalent to the first contact, for what
         # reasons with one (a cycle jump's re-balance, its wear per unit of
