@@ -284,7 +284,7 @@ def test_the_patch_is_triangulated_on_one_blas_thread(tmp_path, monkeypatch):
     from scipy.spatial import Delaunay
     from threadpoolctl import threadpool_info, threadpool_limits
 
-    from meshwear.contact import elastic
+    from meshwear.contact import elastic_patch
 
     threads = []
 
@@ -307,7 +307,7 @@ def test_the_patch_is_triangulated_on_one_blas_thread(tmp_path, monkeypatch):
             threads.append(blas())
             return self.made.transform
 
-    monkeypatch.setattr(elastic, "Delaunay", Spy)
+    monkeypatch.setattr(elastic_patch, "Delaunay", Spy)
     with threadpool_limits(limits=2, user_api="blas"):     # as many as a small machine has
         initial_state(build_model(ball(tmp_path, duration=0.01)))
     assert threads and set(threads) == {1}, threads
