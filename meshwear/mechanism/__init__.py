@@ -3,6 +3,7 @@
 Imports the stages below it (scene, motion, surfaces, contact, kernels).
 """
 
-from .build import (Mechanism, slot_wrench)
+from .build import Mechanism
+from .coupling import slot_wrench
 
 __all__ = ["Mechanism", "slot_wrench"]
