@@ -13,7 +13,7 @@ import pytest
 import cases
 from meshwear.longrun import checkpoint
 from meshwear.cli import main
-from meshwear.mechanism.build import slot_wrench
+from meshwear.mechanism.coupling import slot_wrench
 from meshwear.model.build import build_model, check_time_step, initial_state
 from meshwear.output.memory import MemoryHistory
 from meshwear.scene.format import SceneError, load_scene
@@ -296,7 +296,8 @@ def test_active_sets_are_given_up_only_where_refreshes_come_faster_than_they_pay
     of them over the run than one trial window allows: the pin keeps its
     active set. Turning fast, the disc's rim crosses the margin every few
     steps: every vertex is checked."""
-    from meshwear.mechanism.build import TRIAL_REFRESHES, TRIAL_STEPS, Mechanism
+    from meshwear.mechanism.build import Mechanism
+    from meshwear.mechanism.active_sets import TRIAL_REFRESHES, TRIAL_STEPS
 
     count = []
     refreshed = Mechanism.refreshed

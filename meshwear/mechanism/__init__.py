@@ -3,6 +3,8 @@
 Imports the stages below it (scene, motion, surfaces, contact, kernels).
 """
 
-from .build import (Mechanism, slot_wrench)
+from .active_sets import TRIAL_STEPS, TRIAL_REFRESHES
+from .build import Mechanism
+from .coupling import slot_wrench
 
-__all__ = ["Mechanism", "slot_wrench"]
+__all__ = ["TRIAL_STEPS", "TRIAL_REFRESHES", "Mechanism", "slot_wrench"]
