@@ -1,6 +1,7 @@
 """Contact models: how a vertex presses on a counter-surface (docs/model.md).
 
-- the Winkler (penalty) contact is compiled: :mod:`meshwear.kernels.contact`;
+- :mod:`.winkler`: the Winkler (penalty) contact of one body, on the
+  compiled :mod:`meshwear.kernels.contact`;
 - :mod:`.elastic`: the elastic half-space model in a run, on the solver of
   :mod:`.halfspace` and the grid fields of :mod:`.cellfields`;
 - :mod:`.stability`: the contact's bound on a stable time step.

@@ -25,8 +25,8 @@ from ..geometry import remesh
 from ..surfaces.margin import contact_margin
 from ..contact.elastic import HalfSpace, PatchError
 from ..contact.elastic import step as elastic_step
-from ..kernels.contact import LAW_SLOTS, all_vertices, contact, make_law, rotation_entries
-from ..kernels.counter_wear import settle_counter, wear_counter
+from ..contact.winkler import body_contact
+from ..kernels.contact import LAW_SLOTS, all_vertices, make_law, rotation_entries
 from ..kernels.laws import code_of
 from ..motion.motions import (BalancedMotion, FixedMotion, FreeMotion, GuidedMotion,
                               MechanismMotion, Path, TurningMotion, PrescribedMotion)
@@ -465,46 +465,6 @@ def initial_state(model):
             else:
                 body_contact(model, body, s, at_rest)
     return state
-
-
-def body_contact(model, body, s, law=None):
-    """One step of the contact kernel for one body (planes and mesh surfaces,
-    its active vertices); ``law`` in place of the model's."""
-    contact(s.vertices, s.pose, model.planes, s.vertex_planes, s.active, body.area_vectors,
-            model.law if law is None else law, body.wear_direction, s.contact_state,
-            s.tangential, s.normal_force, s.friction_work, s.wear_depth, s.wear_volume,
-            s.wrench)
-
-
-def settle_counters(model):
-    """Move every lagging vertex of the worn counter-surfaces to its depth
-    (:func:`meshwear.kernels.counter_wear.settle_counter`)."""
-    for surface in model.surfaces.per_vertex:
-        if surface.worn and surface.part is not None:
-            settle_counter(surface.part_tuple())
-
-
-def wear_counters(model, body, s, t, pairs=None):
-    """The wear of the worn counter-surfaces by the step of ``body`` just
-    taken at ``t`` (:func:`meshwear.kernels.counter_wear.wear_counter`).
-    ``pairs``: per slot, the (contact state, normal force) the counter
-    wears by, in place of the body's (the half-space model's: each vertex's
-    energy as a slip of its speed, :mod:`meshwear.elastic`). Returns None,
-    or ``(surface, vertex)``: a counter vertex that sank deeper than its
-    mesh can follow in that step."""
-    P = model.planes.shape[0]
-    for m, surface in enumerate(model.surfaces.per_vertex):
-        if surface.worn:
-            rotation, frame = surface.frame(t)
-            state, force = (s.contact_state[P + m], s.normal_force[P + m]) if pairs is None \
-                else pairs[P + m]
-            worst = wear_counter(s.vertices, s.pose, s.active, body.area_vectors, model.law,
-                                 state, force,
-                                 s.vertex_planes[m], s.hint[m], rotation, frame,
-                                 surface.part_tuple(), m, s.log_index, s.log_value, s.log_count)
-            if worst >= 0:
-                return surface, worst
-    return None
 
 
 def check_time_step(model):
