@@ -48,6 +48,31 @@ def build_model(scene):
     # mesh is built or refined
     periods = _periods(scene)
     _timing(scene, scene.wear.period or (max(periods) if periods else None), math.inf)
+    mechanism, bodies, surface_set = _build_parts(scene)
+    plane_array = surface_set.planes
+
+    run = scene.run
+    law, quasi_static, elastic = _contact_law(scene, bodies)
+    _settle_bodies(scene, bodies, surface_set, plane_array, law)
+    _finish_surfaces(scene, bodies, surface_set, mechanism)
+    period, limit, (dt, n_steps, cycle_steps) = _choose_time_step(scene, bodies, surface_set,
+                                                                   plane_array, law, mechanism)
+    # unbounded surfaces (a plane without a size) are drawn 4 body extents wide
+    extent = 4.0 * max(float(np.ptp(b.reference_vertices, axis=0).max()) for b in bodies)
+    return Model(scene=scene, bodies=bodies, planes=plane_array, law=law, extent=extent,
+                 surfaces=surface_set,
+                 quasi_static=quasi_static, dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
+                 frame_steps=_even_steps(n_steps, run.frames), period=period,
+                 cycle_steps=cycle_steps, mechanism=mechanism, elastic=elastic,
+                 dt_reason=("run.dt" if run.dt != "auto"
+                            else "auto: " + auto_time_step_why(scene, period, limit)[1]))
+
+
+def _build_parts(scene):
+    """``(mechanism, bodies, surface_set)`` of ``scene``: its mechanism (or
+    None), its bodies' :class:`BodyModel`, refined where they face the
+    surfaces, and its counter-surfaces, refined where the bodies can reach
+    them over the run and made worn, riding on the mechanism's bodies."""
     mechanism = None
     if scene.mechanism is not None:
         from ..mechanism.build import Mechanism
@@ -78,6 +103,20 @@ def build_model(scene):
                     scene, surface, bodies, _periods(scene), s.resolution))
             except geometry.MeshError as err:
                 raise SceneError(scene.source, _part_key(f"surface[{j}]", s), str(err)) from None
+    _make_worn(scene, built, bodies)
+    if mechanism is not None:
+        # refined or made worn: the riders anew
+        mechanism.surfaces = []
+        for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
+            if s.mechanism_body is not None:
+                _ride(mechanism, surface, j, s.mechanism_body, 0.0)
+    surface_set = surfaces.SurfaceSet(built)
+    return mechanism, bodies, surface_set
+
+
+def _make_worn(scene, built, bodies):
+    """Make the counter-surfaces with ``wear = true`` among ``built`` worn,
+    spreading a contact's wear over the area a vertex of ``bodies`` stands for."""
     for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
         if getattr(s, "wear", False):
             if scene.wear.acceleration == "cycle_jump" and scene.wear.jump == "explicit":
@@ -90,16 +129,13 @@ def build_model(scene):
             spacing = max((contact_spacing(b, sb) for b, sb in zip(bodies, scene.bodies)),
                           default=0.0)
             surface.spread_over(SPREAD * spacing, SPREAD_BELOW * spacing)
-    if mechanism is not None:
-        # refined or made worn: the riders anew
-        mechanism.surfaces = []
-        for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
-            if s.mechanism_body is not None:
-                _ride(mechanism, surface, j, s.mechanism_body, 0.0)
-    surface_set = surfaces.SurfaceSet(built)
-    plane_array = surface_set.planes
 
-    run = scene.run
+
+def _contact_law(scene, bodies):
+    """``(law, quasi_static, elastic)``: the contact kernel's (13,) law of
+    ``scene`` (no damping without inertia, a Winkler foundation standing in
+    for the half-space model until its first solve), whether the run is
+    quasi-static, and the half-space model's constants (or None)."""
     c = scene.contact
     (ct, ct_area), (dt_point, dt_area) = c.tangential
     law = make_law(friction=c.friction, static_friction=c.static_friction,
@@ -109,7 +145,7 @@ def build_model(scene):
                    tangential_stiffness=ct or 0.0, tangential_stiffness_per_area=ct_area or 0.0,
                    tangential_damping=dt_point or 0.0,
                    tangential_damping_per_area=dt_area or 0.0)
-    quasi_static = run.mode == "quasi-static"
+    quasi_static = scene.run.mode == "quasi-static"
     if quasi_static:  # no inertia, so no damping either
         law[[LAW_SLOTS.index(name) for name in LAW_SLOTS if "damping" in name]] = 0.0
     elastic = None
@@ -123,6 +159,12 @@ def build_model(scene):
         law[LAW_SLOTS.index("tangential_stiffness")] = 0.0
         law[LAW_SLOTS.index("tangential_stiffness_per_area")] = law[
             LAW_SLOTS.index("stiffness_per_area")]
+    return law, quasi_static, elastic
+
+
+def _settle_bodies(scene, bodies, surface_set, plane_array, law):
+    """Refuse a body placed deep inside a surface, and settle a balanced or
+    a turning body on its load at the start (refused if no contact carries it)."""
     for j, (b, config) in enumerate(zip(bodies, scene.bodies)):
         vertex_planes = surfaces.initial_planes(surface_set, b, b.initial_pose, 2.0 * b.radius)[0]
         # where it was placed, before a quasi-static body is settled on its load
@@ -140,6 +182,11 @@ def build_model(scene):
                              f"no surface can carry the load of body {config.name!r} along "
                              f"{list(config.path.free_axis)} (the load pulls it off every "
                              "surface, or no surface faces it along that axis)")
+
+
+def _finish_surfaces(scene, bodies, surface_set, mechanism):
+    """The counter-surfaces once the bodies are placed: which turning meshes
+    are static in shape, their bounds, and the mechanism's riders in slot order."""
     # a turning mesh is static in shape if it is a surface of revolution
     # about its axis, against the smallest active-set margin
     margin = min(surfaces.margin_of(scene, b) for b in bodies)
@@ -153,6 +200,13 @@ def build_model(scene):
         mechanism.surfaces = [(x, slot_of[id(x)], name, placement)
                               for x, _, name, placement in mechanism.surfaces]
         mechanism.finish()
+
+
+def _choose_time_step(scene, bodies, surface_set, plane_array, law, mechanism):
+    """``(period, limit, (dt, n_steps, cycle_steps))``: the motion's cycle
+    (s, or None), the largest stable step (s) and the run's step
+    (:mod:`.timestep`), written into ``law`` and the mechanism."""
+    run = scene.run
     periods = _periods(scene)
     period = scene.wear.period or (max(periods) if periods else None)
     slots = plane_array.shape[0] + len(surface_set.per_vertex)
@@ -171,15 +225,7 @@ def build_model(scene):
             logging.getLogger("meshwear").warning(
                 "%s: run.%s: %d asked, but the run has %d step times (duration / dt + 1): "
                 "writing one at each", scene.source, key, getattr(run, key), n_steps + 1)
-    # unbounded surfaces (a plane without a size) are drawn 4 body extents wide
-    extent = 4.0 * max(float(np.ptp(b.reference_vertices, axis=0).max()) for b in bodies)
-    return Model(scene=scene, bodies=bodies, planes=plane_array, law=law, extent=extent,
-                 surfaces=surface_set,
-                 quasi_static=quasi_static, dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
-                 frame_steps=_even_steps(n_steps, run.frames), period=period,
-                 cycle_steps=cycle_steps, mechanism=mechanism, elastic=elastic,
-                 dt_reason=("run.dt" if run.dt != "auto"
-                            else "auto: " + auto_time_step_why(scene, period, limit)[1]))
+    return period, limit, (dt, n_steps, cycle_steps)
 
 
 def _part_key(prefix, config):
