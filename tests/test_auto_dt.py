@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from meshwear.cli import main
-from meshwear.model.build import (AUTO_STEPS_PER_CYCLE, AUTO_STEPS_PER_RUN, build_model,
-                                  check_time_step, stable_time_step)
+from meshwear.model.build import build_model, check_time_step
+from meshwear.model.timestep import AUTO_STEPS_PER_CYCLE, AUTO_STEPS_PER_RUN, stable_time_step
 from meshwear.scene.format import SceneError, load_scene
 
 # the minimal scene: a steel block dropped on a floor, nothing but

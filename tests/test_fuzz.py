@@ -154,7 +154,7 @@ def test_a_slender_cylinder_is_closed():
 
 
 def test_cycle_jumping_refuses_too_few_steps_per_cycle():
-    from meshwear.model.build import MIN_CYCLE_STEPS
+    from meshwear.model.timestep import MIN_CYCLE_STEPS
 
     outcome = probe(EXAMPLES / "long" / "sphere_fretting_1e5.toml", (("run.dt", 0.5),))  # 1 Hz: 2 a cycle
     assert outcome.code == 2 and f"at least {MIN_CYCLE_STEPS}" in outcome.stderr, outcome

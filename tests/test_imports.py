@@ -126,6 +126,38 @@ def test_the_old_module_paths_warn_and_give_the_new_modules():
     assert done.returncode == 0, done.stderr.strip()[-500:]
 
 
+def test_the_names_that_left_the_model_warn_and_give_the_new_ones():
+    """The per-step functions moved to the stages that run them; their old
+    paths on meshwear.model work for one release, with a warning."""
+    code = ("import importlib, warnings; warnings.simplefilter('error')\n"
+            "import meshwear.model as model\n"
+            "LEFT = {'body_contact': 'meshwear.contact.winkler',\n"
+            "        'settle_counters': 'meshwear.step.counters',\n"
+            "        'wear_counters': 'meshwear.step.counters'}\n"
+            "for name, new in LEFT.items():\n"
+            "    try:\n"
+            "        getattr(model, name)\n"
+            "    except DeprecationWarning as w:\n"
+            "        assert f'{new}.{name}' in str(w), w\n"
+            "    else:\n"
+            "        raise SystemExit(name + ' gave no warning')\n"
+            "try:\n"
+            "    from meshwear.model import wear_counters\n"
+            "except DeprecationWarning:\n"
+            "    pass\n"
+            "else:\n"
+            "    raise SystemExit('from meshwear.model import wear_counters gave no warning')\n"
+            "warnings.simplefilter('ignore')\n"
+            "for name, new in LEFT.items():\n"
+            "    assert getattr(model, name) is getattr(importlib.import_module(new), name), name\n"
+            "    assert name not in model.__all__, name\n"
+            "from meshwear.model import settle_counters, body_contact\n"
+            "assert not hasattr(model, 'no_such_name')\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120, cwd=ROOT)
+    assert done.returncode == 0, done.stderr.strip()[-500:]
+
+
 def test_the_modules_that_were_in_cycles_import_first():
     for name in ("meshwear.geometry.remesh", "meshwear.longrun.wear", "meshwear.output.filled",
                  "meshwear.longrun.jumps", "meshwear.step.simulate", "meshwear.model"):

@@ -893,9 +893,9 @@ def test_the_early_refusal_counts_only_surface_the_refined_bodies_reach(stem, sh
     is small anyway."""
     import dataclasses
 
-    from meshwear import model as model_, surfaces
+    from meshwear import surfaces
     from meshwear.geometry import meshes
-    from meshwear.model import reach
+    from meshwear.model import build as model_, reach
 
     scene = load_scene(f"examples/{stem}.toml")
     built = [surfaces.build_surface(s) for s in scene.surfaces]

@@ -11,7 +11,8 @@ import pytest
 from reference import FACING, contact_areas, point_coefficients
 
 from meshwear.kernels.contact import rotation_entries
-from meshwear.model.build import stable_time_step, build_model
+from meshwear.model.build import build_model
+from meshwear.model.timestep import stable_time_step
 from meshwear.scene.format import SceneError, load_scene
 from meshwear.step.simulate import run_scene
 

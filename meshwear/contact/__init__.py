@@ -1,6 +1,7 @@
 """Contact models: how a vertex presses on a counter-surface (docs/model.md).
 
-- the Winkler (penalty) contact is compiled: :mod:`meshwear.kernels.contact`;
+- :mod:`.winkler`: the Winkler (penalty) contact of one body, on the
+  compiled :mod:`meshwear.kernels.contact`;
 - :mod:`.elastic`: the elastic half-space model in a run (its step and
   what the run reads from it), on the solver of :mod:`.halfspace` and the
   grid fields of :mod:`.cellfields`; the patch and its grid around a
@@ -8,5 +9,5 @@
   Coulomb) :mod:`.elastic_friction`'s;
 - :mod:`.stability`: the contact's bound on a stable time step.
 
-Imports the stages below it (surfaces, motion, geometry, kernels).
+Imports the stages below it (surfaces, motion, scene, geometry, kernels).
 """

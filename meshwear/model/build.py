@@ -1,14 +1,21 @@
-"""Model (frozen: what a scene is) and State (what changes while it runs).
+"""The compile of a scene into its :class:`~meshwear.model.state.Model`, and
+the state a run starts from (docs/model.md, "Bodies, points and
+counter-surfaces").
 
 :func:`build_model` turns a validated :class:`meshwear.scene.Scene` into plain
-arrays once; :func:`initial_state` allocates every per-vertex array a run
-writes into, so a step allocates no state. Kernels see only these arrays.
+arrays once, in phases: the parts (meshes loaded and refined, counter-surfaces
+made worn or riding on a mechanism), the contact law, the bodies settled at
+the start, the time step (:mod:`.timestep`); on the way it refuses what the
+engine cannot run (a body placed inside a surface, a load nothing carries),
+naming the key. :func:`initial_state` allocates every per-vertex array a run
+writes into, so a step allocates no state; :func:`check_time_step` refuses a
+step above the stable one before a run starts (here, beside
+:func:`initial_state`, whose active sets a mechanism's limit is taken on).
 """
 
 import logging
 import math
 import dataclasses
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -16,306 +23,16 @@ from .. import geometry, surfaces
 from . import reach
 from ..geometry import remesh
 from ..surfaces.margin import contact_margin
-from ..motion.dynamics import OwnMotions
 from ..contact.elastic import HalfSpace, PatchError
 from ..contact.elastic import step as elastic_step
-from ..kernels.contact import LAW_SLOTS, all_vertices, contact, make_law, rotation_entries
-from ..kernels.counter_wear import settle_counter, wear_counter
+from ..contact.winkler import body_contact
+from ..kernels.contact import LAW_SLOTS, all_vertices, make_law, rotation_entries
 from ..kernels.laws import code_of
-from ..kernels.nearest import face_frames
 from ..motion.motions import (BalancedMotion, FixedMotion, FreeMotion, GuidedMotion,
                               MechanismMotion, Path, TurningMotion, PrescribedMotion)
 from ..scene.format import SceneError
-from ..contact.stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_stiffness
-
-#: meshwear's own motions, the dynamics of a model without a mechanism
-OWN_MOTIONS = OwnMotions()
-#: ``run.dt = "auto"`` resolves a cycle of the motion into at least this many steps
-AUTO_STEPS_PER_CYCLE = 200
-#: ... and the whole run into at least this many
-AUTO_STEPS_PER_RUN = 1000
-
-
-@dataclass(frozen=True, eq=False)
-class BodyModel:
-    """One worn body, in its body frame (origin at the centre of mass, axes of
-    the mesh file).
-
-    Attributes
-    ----------
-    name : str
-    faces : (m, 3) int64
-    reference_vertices : (n, 3) float
-        Unworn vertices, body frame (m).
-    tributary_area : (n,) float
-        Barycentric vertex areas of the reference mesh (m²).
-    area_vectors : (n, 4) float
-        Area vectors of the reference mesh and their lengths (m², body frame,
-        :func:`meshwear.geometry.area_vectors`): projected on a plane they
-        give each vertex's contact area there.
-    wear_direction : (n, 3) or (0, 3) float
-        Inward vertex normals when wear moves along them, else empty.
-    reference_face_normals : (m, 3) float
-    mass : float
-        kg (nan for fixed or prescribed bodies whose mesh is open).
-    inertia : (3, 3) float
-        About the centre of mass, body frame (kg·m²).
-    origin : (3,) float
-        The mesh file's origin in the body frame (m): history's x, y, z.
-    initial_pose : (13,) float
-    motion : FreeMotion | GuidedMotion | PrescribedMotion | FixedMotion
-    period : float or None
-        Cycle length of the body's path (s).
-    radius : float
-        Largest distance of a vertex from the centre of mass (m).
-    depth_limit : float
-        A body moved by its dynamics (free, guided) stops the run when a
-        vertex in contact is deeper than this (m): :data:`IMPACT_DEPTH` of
-        its thinnest extent; 0 for bodies placed by their path.
-    refinement : dict or None
-        What ``resolution`` did (:func:`meshwear.remesh.refine_part`).
-    margin : float
-        Its default active-set margin (m), used where ``contact.margin`` is
-        not given, and why (``margin_reason``):
-        :func:`meshwear.surfaces.margin.contact_margin`.
-    """
-
-    name: str
-    faces: np.ndarray
-    reference_vertices: np.ndarray
-    tributary_area: np.ndarray
-    area_vectors: np.ndarray
-    wear_direction: np.ndarray
-    reference_face_normals: np.ndarray
-    mass: float
-    inertia: np.ndarray
-    origin: np.ndarray
-    initial_pose: np.ndarray
-    motion: object
-    period: float | None
-    radius: float = 0.0
-    depth_limit: float = 0.0
-    refinement: dict | None = None
-    margin: float = 0.0
-    margin_reason: str = ""
-
-
-@dataclass(frozen=True, eq=False)
-class Model:
-    """Everything about a run that does not change while it runs.
-
-    ``surfaces`` (:class:`meshwear.surfaces.SurfaceSet`) holds the
-    counter-surfaces in contact-slot order: the uniform planes, whose rows
-    form ``planes``, the (P, 4, 3) array the contact kernel takes (point,
-    normal, velocity, angular velocity; moving planes are updated in place),
-    then the per-vertex ones (slots ``P + j``). ``law`` is the kernel's (13,)
-    contact and wear law; ``cull`` says whether bodies keep an active set;
-    ``extent`` (m) is the largest body's size, which unbounded surfaces are
-    drawn at.
-    """
-
-    scene: object
-    bodies: tuple
-    planes: np.ndarray
-    law: np.ndarray
-    quasi_static: bool
-    dt: float
-    n_steps: int
-    sample_steps: np.ndarray
-    frame_steps: np.ndarray
-    period: float | None
-    #: steps per cycle when cycles are jumped over, else 0
-    cycle_steps: int = 0
-    surfaces: object = None
-    cull: bool = True
-    extent: float = 1.0
-    #: the MuJoCo mechanism the riders move with (:mod:`meshwear.mechanism`), or None
-    mechanism: object = None
-    #: the half-space contact's constants (:class:`meshwear.elastic.HalfSpace`),
-    #: or None: the Winkler foundation of ``law``
-    elastic: object = None
-    #: what set ``dt``: "run.dt", or the limit of ``"auto"`` that did (:func:`auto_time_step_why`)
-    dt_reason: str = "run.dt"
-
-    @property
-    def dynamics(self):
-        """What moves the parts (:mod:`meshwear.dynamics`): the mechanism, or
-        meshwear's own motions."""
-        return self.mechanism if self.mechanism is not None else OWN_MOTIONS
-
-    def __post_init__(self):
-        steps = np.union1d(np.union1d(self.sample_steps, self.frame_steps), [self.n_steps])
-        object.__setattr__(self, "output_steps", steps.astype(np.int64))
-        object.__setattr__(self, "output_steps_set", set(steps.tolist()))
-        object.__setattr__(self, "sample_set", set(self.sample_steps.tolist()))
-        object.__setattr__(self, "frame_set", set(self.frame_steps.tolist()))
-
-    @property
-    def duration(self):
-        return self.n_steps * self.dt
-
-    @property
-    def worn_counters(self):
-        """Some counter-surface wears."""
-        return bool(self.surfaces) and any(m.worn for m in self.surfaces.per_vertex)
-
-    @property
-    def slots(self):
-        """Number of counter-surfaces: planes, then the per-vertex ones."""
-        return self.planes.shape[0] + (len(self.surfaces.per_vertex) if self.surfaces else 0)
-
-
-@dataclass(eq=False)
-class BodyState:
-    """What changes for one body; every array is allocated once.
-
-    Attributes
-    ----------
-    pose : (13,) float
-        Centre of mass, quaternion, velocity, angular velocity (world).
-    vertices : (n, 3) float
-        Worn vertices in the body frame (m).
-    wear_depth, friction_work, wear_volume : (n,) float
-        ``w`` (m), ``E`` (J) and worn volume (m³) per vertex.
-    contact_state : (S, n) int8
-        Per counter-surface (planes, then meshes).
-    tangential : (S, n, 4, 3) float
-        Stick anchor, stick-start force, friction force, last slip velocity.
-    normal_force : (S, n) float
-    wrench : (6,) float
-        Contact force and torque about the centre of mass in the last step.
-    vertex_planes : (M, n, 3, 3) float
-        Per per-vertex surface (analytic or mesh), the plane under each
-        active vertex.
-    hint : (M, n) int64
-        Per mesh surface, the face under each vertex at the last query (-1: none).
-    active : (k,) int64
-        The vertices within reach of a surface (:mod:`meshwear.surfaces`).
-    active_wear : (k,) float
-        Their wear depth when the active set was last refreshed.
-    cull : (9,) float
-        Margin, time and pose of the last active-set refresh.
-    """
-
-    pose: np.ndarray
-    vertices: np.ndarray
-    wear_depth: np.ndarray
-    friction_work: np.ndarray
-    wear_volume: np.ndarray
-    contact_state: np.ndarray
-    tangential: np.ndarray
-    normal_force: np.ndarray
-    wrench: np.ndarray = field(default_factory=lambda: np.zeros(6))
-    vertex_planes: np.ndarray = None
-    hint: np.ndarray = None
-    active: np.ndarray = None
-    active_wear: np.ndarray = None
-    cull: np.ndarray = None
-    cull_scratch: object = None
-    #: (5, n) each vertex's total normal force (N), total squared normal
-    #: force (N²) and total force vector along the normals (N, world) added
-    #: up over the steps since they were last zeroed, kept while cycles are
-    #: jumped over (:data:`meshwear.jumps.LOAD_ROWS`); else (2, 0)
-    load: np.ndarray = field(default_factory=lambda: np.zeros((2, 0)))
-    #: (1,) how much nearer (m) the body may come to a surface before its
-    #: deepest vertex in contact has to be measured again against its
-    #: ``depth_limit`` (docs/model.md, "Impacts"); 0: at the next step
-    impact_room: np.ndarray = field(default_factory=lambda: np.zeros(1))
-    #: the pairs' shares of the worn counter-surfaces' vertices, logged
-    #: over a measured cycle for implicit jumps (:func:`meshwear.jumps.pair_log`):
-    #: rows (surface, vertex, counter vertex) and the pair's normal force on
-    #: the counter vertex (N), the rows used and whether to log (0 rows: not kept)
-    log_index: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.int64))
-    log_value: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    log_count: np.ndarray = field(default_factory=lambda: np.zeros(2, np.int64))
-    #: the step from which the log holds every pair (-1: none)
-    log_from: int = -1
-    #: the half-space solve kept from step to step (:class:`meshwear.elastic.Patch`;
-    #: a cache, not saved in checkpoints), or None
-    elastic: object = None
-
-
-@dataclass(eq=False)
-class PartState:
-    """What wear changes on a worn mesh counter-surface (its own frame).
-
-    Attributes
-    ----------
-    vertices : (V, 3) float
-        Worn vertices (m).
-    frames : (F, 4, 4) float
-        Their faces' frames (:func:`meshwear.kernels.nearest.face_frames`).
-    depth, volume, work : (V,) float
-        Wear depth (m), worn volume (m³) and friction work (J) per vertex.
-    added, touched, limit, due, count : (V,) float, (V,) int64, (V,) float, (V,) int64, (1,) int64
-        Each vertex's lag (the depth it took since it last moved), the
-        lagging vertices (``count`` of them), the lag at which each moves and
-        scratch (:func:`meshwear.kernels.counter_wear.wear_counter`); none lag
-        between two stretches of steps (:func:`settle_counters`).
-    stiffness : (V,) or (0,) float
-        How much each vertex's wear falls per unit of its own depth, summed
-        over the steps since it was zeroed (kept for implicit cycle jumps;
-        (0,): not kept).
-    place : (V,) int64
-        Where each lagging vertex is in ``touched``, -1 for the others.
-    pending, pending_list, pending_place, pending_count : (9, F) float, (F,) int64, (F,) int64, (1,) int64
-        What waits on each face to be spread over the vertices around it
-        (volume, energy, penetration, direction of sliding and contact point
-        times volume), the faces with some, each one's place
-        among them and their count (a spreading part:
-        :func:`meshwear.kernels.counter_wear.wear_counter`); nothing waits
-        between two stretches of steps.
-    """
-
-    vertices: np.ndarray
-    frames: np.ndarray
-    depth: np.ndarray
-    volume: np.ndarray
-    work: np.ndarray
-    added: np.ndarray
-    touched: np.ndarray
-    limit: np.ndarray
-    due: np.ndarray
-    count: np.ndarray
-    stiffness: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    place: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    pending: np.ndarray = field(default_factory=lambda: np.zeros((9, 0)))
-    pending_list: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    pending_place: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    pending_count: np.ndarray = field(default_factory=lambda: np.zeros(1, np.int64))
-
-    @classmethod
-    def unworn(cls, surface, stiffness=False):
-        """The unworn state of ``surface``; ``stiffness``: keep each vertex's."""
-        n = len(surface.reference_vertices)
-        return cls(vertices=surface.reference_vertices.copy(),
-                   frames=face_frames(surface.reference_vertices, surface.faces),
-                   depth=np.zeros(n), volume=np.zeros(n), work=np.zeros(n), added=np.zeros(n),
-                   touched=np.zeros(n, np.int64), limit=np.full(n, np.inf),
-                   due=np.zeros(n, np.int64), count=np.zeros(1, np.int64),
-                   stiffness=np.zeros(n if stiffness else 0), place=np.full(n, -1, np.int64),
-                   pending=np.zeros((9, len(surface.faces))),
-                   pending_list=np.zeros(len(surface.faces), np.int64),
-                   pending_place=np.full(len(surface.faces), -1, np.int64),
-                   pending_count=np.zeros(1, np.int64))
-
-
-@dataclass(eq=False)
-class State:
-    """Where a run is: ``step`` steps of ``dt`` represented (``time``), the
-    bodies' state, the last step whose outputs are written, the cycle
-    jumping's bookkeeping (:class:`meshwear.wear.JumpState`, or None) and
-    whether the state was reached by steps (``resolved``) or by a jump."""
-
-    time: float
-    step: int
-    bodies: list
-    written: int = -1
-    jump: object = None
-    #: False from a cycle jump until the next step: the state is extrapolated
-    resolved: bool = True
-    #: per per-vertex surface, its :class:`PartState` if it wears, else None
-    parts: list = field(default_factory=list)
+from .state import BodyModel, BodyState, Model, PartState, State
+from .timestep import _even_steps, _stable_limit, _timing, auto_time_step_why, stable_time_step
 
 
 def build_model(scene):
@@ -331,6 +48,31 @@ def build_model(scene):
     # mesh is built or refined
     periods = _periods(scene)
     _timing(scene, scene.wear.period or (max(periods) if periods else None), math.inf)
+    mechanism, bodies, surface_set = _build_parts(scene)
+    plane_array = surface_set.planes
+
+    run = scene.run
+    law, quasi_static, elastic = _contact_law(scene, bodies)
+    _settle_bodies(scene, bodies, surface_set, plane_array, law)
+    _finish_surfaces(scene, bodies, surface_set, mechanism)
+    period, limit, (dt, n_steps, cycle_steps) = _choose_time_step(scene, bodies, surface_set,
+                                                                   plane_array, law, mechanism)
+    # unbounded surfaces (a plane without a size) are drawn 4 body extents wide
+    extent = 4.0 * max(float(np.ptp(b.reference_vertices, axis=0).max()) for b in bodies)
+    return Model(scene=scene, bodies=bodies, planes=plane_array, law=law, extent=extent,
+                 surfaces=surface_set,
+                 quasi_static=quasi_static, dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
+                 frame_steps=_even_steps(n_steps, run.frames), period=period,
+                 cycle_steps=cycle_steps, mechanism=mechanism, elastic=elastic,
+                 dt_reason=("run.dt" if run.dt != "auto"
+                            else "auto: " + auto_time_step_why(scene, period, limit)[1]))
+
+
+def _build_parts(scene):
+    """``(mechanism, bodies, surface_set)`` of ``scene``: its mechanism (or
+    None), its bodies' :class:`BodyModel`, refined where they face the
+    surfaces, and its counter-surfaces, refined where the bodies can reach
+    them over the run and made worn, riding on the mechanism's bodies."""
     mechanism = None
     if scene.mechanism is not None:
         from ..mechanism.build import Mechanism
@@ -361,6 +103,20 @@ def build_model(scene):
                     scene, surface, bodies, _periods(scene), s.resolution))
             except geometry.MeshError as err:
                 raise SceneError(scene.source, _part_key(f"surface[{j}]", s), str(err)) from None
+    _make_worn(scene, built, bodies)
+    if mechanism is not None:
+        # refined or made worn: the riders anew
+        mechanism.surfaces = []
+        for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
+            if s.mechanism_body is not None:
+                _ride(mechanism, surface, j, s.mechanism_body, 0.0)
+    surface_set = surfaces.SurfaceSet(built)
+    return mechanism, bodies, surface_set
+
+
+def _make_worn(scene, built, bodies):
+    """Make the counter-surfaces with ``wear = true`` among ``built`` worn,
+    spreading a contact's wear over the area a vertex of ``bodies`` stands for."""
     for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
         if getattr(s, "wear", False):
             if scene.wear.acceleration == "cycle_jump" and scene.wear.jump == "explicit":
@@ -373,16 +129,13 @@ def build_model(scene):
             spacing = max((contact_spacing(b, sb) for b, sb in zip(bodies, scene.bodies)),
                           default=0.0)
             surface.spread_over(SPREAD * spacing, SPREAD_BELOW * spacing)
-    if mechanism is not None:
-        # refined or made worn: the riders anew
-        mechanism.surfaces = []
-        for j, (surface, s) in enumerate(zip(built, scene.surfaces)):
-            if s.mechanism_body is not None:
-                _ride(mechanism, surface, j, s.mechanism_body, 0.0)
-    surface_set = surfaces.SurfaceSet(built)
-    plane_array = surface_set.planes
 
-    run = scene.run
+
+def _contact_law(scene, bodies):
+    """``(law, quasi_static, elastic)``: the contact kernel's (13,) law of
+    ``scene`` (no damping without inertia, a Winkler foundation standing in
+    for the half-space model until its first solve), whether the run is
+    quasi-static, and the half-space model's constants (or None)."""
     c = scene.contact
     (ct, ct_area), (dt_point, dt_area) = c.tangential
     law = make_law(friction=c.friction, static_friction=c.static_friction,
@@ -392,7 +145,7 @@ def build_model(scene):
                    tangential_stiffness=ct or 0.0, tangential_stiffness_per_area=ct_area or 0.0,
                    tangential_damping=dt_point or 0.0,
                    tangential_damping_per_area=dt_area or 0.0)
-    quasi_static = run.mode == "quasi-static"
+    quasi_static = scene.run.mode == "quasi-static"
     if quasi_static:  # no inertia, so no damping either
         law[[LAW_SLOTS.index(name) for name in LAW_SLOTS if "damping" in name]] = 0.0
     elastic = None
@@ -406,6 +159,12 @@ def build_model(scene):
         law[LAW_SLOTS.index("tangential_stiffness")] = 0.0
         law[LAW_SLOTS.index("tangential_stiffness_per_area")] = law[
             LAW_SLOTS.index("stiffness_per_area")]
+    return law, quasi_static, elastic
+
+
+def _settle_bodies(scene, bodies, surface_set, plane_array, law):
+    """Refuse a body placed deep inside a surface, and settle a balanced or
+    a turning body on its load at the start (refused if no contact carries it)."""
     for j, (b, config) in enumerate(zip(bodies, scene.bodies)):
         vertex_planes = surfaces.initial_planes(surface_set, b, b.initial_pose, 2.0 * b.radius)[0]
         # where it was placed, before a quasi-static body is settled on its load
@@ -423,6 +182,11 @@ def build_model(scene):
                              f"no surface can carry the load of body {config.name!r} along "
                              f"{list(config.path.free_axis)} (the load pulls it off every "
                              "surface, or no surface faces it along that axis)")
+
+
+def _finish_surfaces(scene, bodies, surface_set, mechanism):
+    """The counter-surfaces once the bodies are placed: which turning meshes
+    are static in shape, their bounds, and the mechanism's riders in slot order."""
     # a turning mesh is static in shape if it is a surface of revolution
     # about its axis, against the smallest active-set margin
     margin = min(surfaces.margin_of(scene, b) for b in bodies)
@@ -436,6 +200,13 @@ def build_model(scene):
         mechanism.surfaces = [(x, slot_of[id(x)], name, placement)
                               for x, _, name, placement in mechanism.surfaces]
         mechanism.finish()
+
+
+def _choose_time_step(scene, bodies, surface_set, plane_array, law, mechanism):
+    """``(period, limit, (dt, n_steps, cycle_steps))``: the motion's cycle
+    (s, or None), the largest stable step (s) and the run's step
+    (:mod:`.timestep`), written into ``law`` and the mechanism."""
+    run = scene.run
     periods = _periods(scene)
     period = scene.wear.period or (max(periods) if periods else None)
     slots = plane_array.shape[0] + len(surface_set.per_vertex)
@@ -454,15 +225,7 @@ def build_model(scene):
             logging.getLogger("meshwear").warning(
                 "%s: run.%s: %d asked, but the run has %d step times (duration / dt + 1): "
                 "writing one at each", scene.source, key, getattr(run, key), n_steps + 1)
-    # unbounded surfaces (a plane without a size) are drawn 4 body extents wide
-    extent = 4.0 * max(float(np.ptp(b.reference_vertices, axis=0).max()) for b in bodies)
-    return Model(scene=scene, bodies=bodies, planes=plane_array, law=law, extent=extent,
-                 surfaces=surface_set,
-                 quasi_static=quasi_static, dt=dt, n_steps=n_steps, sample_steps=_even_steps(n_steps, run.history),
-                 frame_steps=_even_steps(n_steps, run.frames), period=period,
-                 cycle_steps=cycle_steps, mechanism=mechanism, elastic=elastic,
-                 dt_reason=("run.dt" if run.dt != "auto"
-                            else "auto: " + auto_time_step_why(scene, period, limit)[1]))
+    return period, limit, (dt, n_steps, cycle_steps)
 
 
 def _part_key(prefix, config):
@@ -546,77 +309,6 @@ def _periods(scene):
              + [b.path.rotation for b in scene.bodies if b.path is not None])
     out += [2.0 * np.pi / abs(r.rate) for r in turns if r is not None and r.rate != 0.0]
     return [p for p in out if p is not None]
-
-
-def auto_time_step(scene, period, limit):
-    """The step ``run.dt = "auto"`` stands for (s): the largest stable step
-    ``limit`` of the bodies integrated in time, and no longer than a
-    :data:`AUTO_STEPS_PER_CYCLE`-th of the motion's cycle ``period`` (None
-    when nothing moves periodically) or a :data:`AUTO_STEPS_PER_RUN`-th of
-    the duration."""
-    return auto_time_step_why(scene, period, limit)[0]
-
-
-def auto_time_step_why(scene, period, limit):
-    """:func:`auto_time_step` and which of its limits set it, in words."""
-    choices = [(scene.run.duration / AUTO_STEPS_PER_RUN,
-                f"1/{AUTO_STEPS_PER_RUN} of the duration")]
-    if period is not None:
-        choices.append((period / AUTO_STEPS_PER_CYCLE,
-                        f"1/{AUTO_STEPS_PER_CYCLE} of the {period:.4g} s cycle"))
-    choices.append((limit, "the largest stable step"))
-    return min(choices, key=lambda c: c[0])
-
-
-#: most steps a run may take (counts stay exact in float64 times)
-MAX_STEPS = 10**15
-#: fewest steps per cycle cycle jumping accepts (one or two alias an oscillation away)
-MIN_CYCLE_STEPS = 4
-
-
-def _timing(scene, period, limit):
-    """``(dt, n_steps, cycle_steps)`` of a run: the step asked (or
-    :func:`auto_time_step`) shortened so the duration is whole steps; when
-    cycles are jumped over, so a cycle is whole steps (``cycle_steps``, else
-    0) and the duration whole cycles' steps. Never longer than asked."""
-    asked = scene.run.dt
-    if asked == "auto":
-        asked = auto_time_step(scene, period, limit)
-    key = "run.dt" if scene.run.dt != "auto" else "run.duration"
-    if scene.wear.acceleration != "cycle_jump":
-        n_steps = _step_count(scene, key, scene.run.duration / asked)
-        return scene.run.duration / n_steps, n_steps, 0
-    for j, b in enumerate(scene.bodies):
-        if b.motion == "free":
-            raise SceneError(scene.source, f"body[{j}].motion", "'free' bodies have no cycle to "
-                             "jump over; wear.acceleration = 'cycle_jump' needs guided, "
-                             "prescribed or fixed bodies")
-    cycle_steps = _step_count(scene, key, period / asked)
-    if cycle_steps < MIN_CYCLE_STEPS:
-        raise SceneError(scene.source, "run.dt", f"{asked:.6g} s gives {cycle_steps} step(s) "
-                         f"per cycle of {period:.6g} s; cycle jumping needs at least "
-                         f"{MIN_CYCLE_STEPS} to resolve the cycle it extrapolates")
-    dt = period / cycle_steps
-    n_steps = _step_count(scene, "run.duration", scene.run.duration / dt, round)
-    return dt, n_steps, cycle_steps
-
-
-def _step_count(scene, key, ratio, rounding=None):
-    """A count of steps ``ratio`` rounded up (or by ``rounding``), at least 1:
-    a SceneError naming ``key`` if it is more than :data:`MAX_STEPS`."""
-    if not ratio <= MAX_STEPS:
-        raise SceneError(scene.source, key, f"the run would take {ratio:.3g} steps, more than "
-                         f"{MAX_STEPS:.0e}; a longer dt or a shorter duration")
-    return max(1, int(rounding(ratio) if rounding else math.ceil(ratio - 1e-9)))
-
-
-def _even_steps(n_steps, count):
-    """Step indices of ``count`` evenly spaced samples, first 0, last n_steps."""
-    if count <= 0:
-        return np.zeros(0, dtype=np.int64)
-    if count == 1:
-        return np.zeros(1, dtype=np.int64)
-    return np.unique(np.rint(np.linspace(0, n_steps, count)).astype(np.int64))
 
 
 def _build_body(scene, index, body, surface_set, mechanism=None, loaded=None):
@@ -821,93 +513,8 @@ def initial_state(model):
     return state
 
 
-def body_contact(model, body, s, law=None):
-    """One step of the contact kernel for one body (planes and mesh surfaces,
-    its active vertices); ``law`` in place of the model's."""
-    contact(s.vertices, s.pose, model.planes, s.vertex_planes, s.active, body.area_vectors,
-            model.law if law is None else law, body.wear_direction, s.contact_state,
-            s.tangential, s.normal_force, s.friction_work, s.wear_depth, s.wear_volume,
-            s.wrench)
-
-
-def settle_counters(model):
-    """Move every lagging vertex of the worn counter-surfaces to its depth
-    (:func:`meshwear.kernels.counter_wear.settle_counter`)."""
-    for surface in model.surfaces.per_vertex:
-        if surface.worn and surface.part is not None:
-            settle_counter(surface.part_tuple())
-
-
-def wear_counters(model, body, s, t, pairs=None):
-    """The wear of the worn counter-surfaces by the step of ``body`` just
-    taken at ``t`` (:func:`meshwear.kernels.counter_wear.wear_counter`).
-    ``pairs``: per slot, the (contact state, normal force) the counter
-    wears by, in place of the body's (the half-space model's: each vertex's
-    energy as a slip of its speed, :mod:`meshwear.elastic`). Returns None,
-    or ``(surface, vertex)``: a counter vertex that sank deeper than its
-    mesh can follow in that step."""
-    P = model.planes.shape[0]
-    for m, surface in enumerate(model.surfaces.per_vertex):
-        if surface.worn:
-            rotation, frame = surface.frame(t)
-            state, force = (s.contact_state[P + m], s.normal_force[P + m]) if pairs is None \
-                else pairs[P + m]
-            worst = wear_counter(s.vertices, s.pose, s.active, body.area_vectors, model.law,
-                                 state, force,
-                                 s.vertex_planes[m], s.hint[m], rotation, frame,
-                                 surface.part_tuple(), m, s.log_index, s.log_value, s.log_count)
-            if worst >= 0:
-                return surface, worst
-    return None
-
-
-def stable_time_step(model):
-    """Largest stable time step (s) of the dynamic bodies, and the body that sets it.
-
-    Bound: the contact stiffness of every vertex acting in all three directions
-    and against every plane at once, ``K = P sum_i max(c_i, c_t,i) J_i^T J_i``
-    with ``J_i = [I, -[r_i]x]`` and ``P`` planes, is at least the stiffness of
-    any real contact configuration, so its largest
-    generalised eigenvalue against the mass matrix bounds the fastest contact
-    mode, rotations included. Each mode ``omega`` with damping ratio ``zeta``
-    is stable under the symplectic Euler step for
-    ``dt <= 2 (sqrt(1 + zeta^2) - zeta) / omega``; the result is that bound
-    times :data:`STABILITY_MARGIN`. Returns ``(inf, None)`` when no body is
-    integrated in time.
-    """
-    own = _stable_limit(model.bodies, model.law, model.slots)
-    moved = model.dynamics.stable_limit(model.bodies, model.law, model.slots)
-    return own if own[0] <= moved[0] else moved
-
-
-def _stable_limit(bodies, law, slots):
-    """:func:`stable_time_step` of ``bodies`` under the contact ``law`` with
-    ``slots`` counter-surfaces."""
-    best, who = np.inf, None
-    for b in bodies:
-        kind = b.motion.dynamic_axes
-        if kind is None or isinstance(b.motion, MechanismMotion):
-            continue        # a mechanism's riders: Mechanism.stable_limit
-        # a vertex may press on every plane at once (a box in a corner)
-        planes = max(1, slots)
-        k, d = (planes * x for x in vertex_stiffness(b, law))
-        if kind == "axis":
-            K = np.array([[k.sum()]])
-            C = np.array([[d.sum()]])
-            M = np.array([[b.mass]])
-        else:
-            K, C = contact_matrix(k, b.reference_vertices), contact_matrix(d, b.reference_vertices)
-            M = np.zeros((6, 6))
-            M[:3, :3] = b.mass * np.eye(3)
-            M[3:, 3:] = b.inertia
-        dt = stable_step(K, C, M)
-        if dt < best:
-            best, who = dt, b.name
-    return STABILITY_MARGIN * best, who
-
-
 def check_time_step(model):
-    """Refuse a ``run.dt`` above :func:`stable_time_step`, or one in which a
+    """Refuse a ``run.dt`` above :func:`~.timestep.stable_time_step`, or one in which a
     dynamic body's starting speed carries it deeper than its ``depth_limit``;
     return the limit.
 
@@ -955,5 +562,3 @@ def check_time_step(model):
     raise SceneError(model.scene.source, "run.dt",
                      f"{asked!r} s{rounded} is above the stability limit of the contact "
                      f"on body {who!r}; the largest stable dt is {limit:.6g} s")
-
-

@@ -17,12 +17,14 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from ..contact import elastic
+from ..contact.winkler import body_contact
 from . import stepper
 from .. import surfaces
 from ..geometry.properties import inverted_faces
 from ..kernels.loop import deepest_penetration, impact_check, use_impact_room
 from ..kernels.rigid import TURNING
-from ..model.build import IMPACT_DEPTH, body_contact, settle_counters, wear_counters
+from ..model.build import IMPACT_DEPTH
+from .counters import settle_counters, wear_counters
 from ..output.memory import MemoryHistory
 from ..longrun.wear import run_cycle_jump
 
