@@ -3,6 +3,7 @@ each importing only its own stage and the stages below it, so any module can
 be imported first."""
 
 import ast
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -164,3 +165,31 @@ def test_the_modules_that_were_in_cycles_import_first():
         done = subprocess.run([sys.executable, "-c", f"import {name}"], capture_output=True,
                               text=True, timeout=120, cwd=ROOT)
         assert done.returncode == 0, f"import {name} first: {done.stderr.strip()[-300:]}"
+
+
+def _code_map():
+    """The files docs/index.md's code map names, as paths under meshwear/."""
+    text = (ROOT / "docs" / "index.md").read_text()
+    block = text.split("### Code map", 1)[1].split("```", 2)[1]
+    named, folder = set(), ""
+    for line in block.splitlines():
+        depth = len(line) - len(line.lstrip())
+        words = line.split()
+        if depth == 2 and words and words[0].endswith("/"):
+            folder = words[0]
+        elif depth == 2:
+            folder = ""
+        names = re.findall(r"\b([a-z_]+\.py)\b", line.split("  ", 2)[-1] if depth == 4 else line)
+        if depth == 4:
+            names = re.findall(r"\b([a-z_]+\.py)\b", line.strip().split("   ")[0])
+        named.update(folder + n for n in names)
+    return named
+
+
+def test_the_code_map_names_every_module_and_no_other():
+    on_disk = {str(p.relative_to(PACKAGE)) for p in PACKAGE.rglob("*.py") if p.name != "__init__.py"}
+    named = _code_map()
+    assert named == on_disk, (f"not in docs/index.md's code map: {sorted(on_disk - named)}; "
+                              f"named there but no such file: {sorted(named - on_disk)}")
+    folders = {p.parent.name for p in PACKAGE.rglob("__init__.py") if p.parent != PACKAGE}
+    assert folders == set(STAGES) - {"top"}

@@ -144,6 +144,13 @@ def plane_under(planes, vertex_planes, n_planes, s, i):
             vertex_planes[m, i, 1, 0], vertex_planes[m, i, 1, 1], vertex_planes[m, i, 1, 2])
 
 
+# One function of about 230 lines, and on purpose: it is the inner loop over
+# every active vertex, and the pose, the law's coefficients and each plane's
+# normal are read into scalars once, before it. Pieces of it as functions
+# would take those twenty-odd scalars as arguments per vertex, and the
+# ONE_PLANE / ONE_SURFACE builds rely on LLVM seeing the whole loop to drop
+# the branches a build never takes (docs/performance.md, "Contact kernel
+# throughput").
 def _contact(body_vertices, pose, planes, vertex_planes, active, area, law, wear_direction,
              contact_state, tangential, normal_force,
              friction_work, wear_depth, wear_volume, wrench):

@@ -248,6 +248,12 @@ def _search_tree(yx, yy, yz, frames, faces, counter_vertices, boxes, nodes, orde
     return best, best_d2, best_delta, kept, kept_d2, kept_delta
 
 
+# About 200 lines, and on purpose: the loop over the active vertices, with
+# the counter frame's motion and the body's pose read once into scalars
+# before it (read from the arrays, they would be read again for each vertex
+# after each write to ``out``); the face tests and the tree search it falls
+# back on are functions of their own (:func:`_consider_at`, :func:`_released`,
+# :func:`_search_tree`).
 def _nearest_planes(body_vertices, pose, active, rotation, motion, counter_vertices, faces,
                     frames, corner_normals, search, boxes, nodes, order, neighbours, out,
                     distance, hint, fixed, steady):
