@@ -45,12 +45,12 @@ resolved cycle. Outputs falling inside a jumped span are filled from the jump
 dynamic mode the cycle after a jump only lets the contact settle and the
 next one is measured.
 
-This module holds the controller (:func:`run_cycle_jump`) and its memory
-(:class:`JumpState`); choosing ``J`` is :mod:`meshwear.longrun.jump_choice`,
-the errors it keeps and the run's :func:`error_estimate`
-:mod:`meshwear.longrun.jump_errors`, the volume a load-carrying body's jump
-wears :mod:`meshwear.longrun.jump_volume`, and taking the jump
-:mod:`meshwear.longrun.extrapolate`.
+This module holds the controller (:func:`run_cycle_jump`, one pass of its
+loop per measurement) and its memory (:class:`JumpState`); choosing ``J`` is
+:mod:`meshwear.longrun.jump_choice`, the errors it keeps and the run's
+:func:`error_estimate` :mod:`meshwear.longrun.jump_errors`, the volume a
+load-carrying body's jump wears :mod:`meshwear.longrun.jump_volume`, and
+taking the jump :mod:`meshwear.longrun.extrapolate`.
 """
 
 import time
@@ -153,6 +153,36 @@ class JumpState:
         return error_estimate(state)
 
 
+@dataclass
+class _Measurement:
+    """One pass of the controller's loop: the ``window`` resolved cycles
+    from step ``start`` to ``stop`` that a measurement averages
+    (:func:`_resolve`), and what the jump after it reads of them
+    (:func:`_measure`)."""
+
+    start: int                      # the step it began at
+    before: list                    # per body (wear_depth, vertices, wear_volume,
+                                    # friction_work) at its start
+    before_parts: list              # per worn counter-part (depth, volume, work) at its start
+    starts: list                    # per body its penetrations at its start
+                                    # (jumps.start_depths; None: explicit, or at t = 0)
+    window: int                     # the resolved cycles it averages
+    stop: int                       # the step it ends at
+    end_limit: int                  # the most cycles a jump after it may cover (the run
+                                    # ends with a resolved cycle)
+    could: int                      # the cycles its outputs were recorded for
+    snapshots: object               # those records (meshwear.output.filled.record)
+    rates: list = None              # per body (n,) wear per cycle
+    part_rates: list = None         # per worn counter-part (V,) wear per cycle
+    measures: list = None           # per body its jumps.measure (implicit; None: explicit)
+    middle: float = 0.0             # its middle (cycles)
+    increments: list = None         # per per-vertex surface: a worn counter-part's wear
+                                    # per cycle (None: not worn)
+    settled: list = None            # per per-vertex surface: the rates it settles to
+    stiffness: list = None          # per per-vertex surface: its stiffness per cycle,
+                                    # summed in the wear kernel (implicit)
+
+
 def run_cycle_jump(model, state, advance, check, observers=(), progress=None, checkpoint=None,
                    forced_jump=None):
     """Run ``state`` to the end of ``model``'s duration, jumping over cycles.
@@ -164,11 +194,42 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
     ``forced_jump`` replaces the controller by a fixed jump (still stopping
     at the end): the fixed-factor scheme of finite-element wear codes, for
     comparisons and tests.
+
+    Each pass resolves a measurement (:func:`_resolve`), reads its rates
+    (:func:`_measure`), chooses the jump (:func:`_choose`), takes it
+    (:func:`_take`) and keeps what the next pass grows from
+    (:func:`_remember`).
     """
     n_c = model.cycle_steps
     tolerance = model.scene.wear.tolerance
     implicit = model.scene.wear.jump == "implicit"
     parts = [(j, part) for j, part in enumerate(state.parts) if part is not None]
+    js = _controller_state(model, state, parts)
+    while state.step < model.n_steps:
+        cycle = _resolve(model, state, js, parts, implicit, advance, observers, progress,
+                         forced_jump)
+        if cycle.stop - cycle.start < n_c or state.step >= model.n_steps:
+            break
+        if js.settling:
+            js.settling = False
+            continue
+        _measure(model, state, js, parts, implicit, cycle)
+        jump, which, results = _choose(model, state, js, parts, implicit, tolerance, cycle,
+                                       forced_jump)
+        if jump > 0:
+            _take(model, state, js, parts, implicit, cycle, jump, which, results, observers,
+                  check, forced_jump)
+        _remember(js, parts, implicit, cycle, jump, which, forced_jump)
+        if checkpoint is not None:
+            checkpoint(model, state)
+    return state
+
+
+def _controller_state(model, state, parts):
+    """``state``'s :class:`JumpState`, made at the run's start (or read from
+    a checkpoint), its per-body and per-part lists sized to ``model`` and
+    the worn counter-parts ``parts`` ((surface index, part) pairs), and each
+    body's load log sized to its vertices."""
     if state.jump is None:
         state.jump = JumpState(rate=[None] * len(model.bodies),
                                error=[np.zeros(len(b.tributary_area)) for b in model.bodies],
@@ -191,187 +252,235 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
     for body, s in zip(model.bodies, state.bodies):
         if s.load.shape != (jumps.LOAD_ROWS, len(s.wear_depth)):
             s.load = np.zeros((jumps.LOAD_ROWS, len(s.wear_depth)))
-    while state.step < model.n_steps:
-        start = js.cycle_start = state.step
-        before = [(s.wear_depth.copy(), s.vertices.copy(), s.wear_volume.copy(),
-                   s.friction_work.copy()) for s in state.bodies]
-        before_parts = [(p.depth.copy(), p.volume.copy(), p.work.copy()) for _, p in parts]
-        # the penetrations at the cycle's start, to see each one's change at
-        # the same phase (the state at t = 0 is not yet placed in balance)
-        starts = ([jumps.start_depths(model, body, s) for body, s in zip(model.bodies,
-                                                                          state.bodies)]
-                  if implicit and start > 0 else [None] * len(model.bodies))
-        for s in state.bodies:
-            s.load[:] = 0.0
-        for _, part in parts:
-            part.stiffness[:] = 0.0      # each counter vertex's, summed over the measurement
-        if implicit and parts:
-            for s in state.bodies:       # the pairs that wear the counters, over the measurement
-                jumps.start_log(s, start, js.window * n_c)
-        # a measurement averages the wear of ``window`` consecutive cycles
-        # (one, unless single cycles disagree): the last one is recorded for
-        # the outputs a jump after it fills
-        window = js.window
-        stop = min(start + window * n_c, model.n_steps)
-        last = max(start, stop - n_c)
-        if last > start:
-            advance(model, state, last, observers, progress)
-        # the cycles a jump after this one may cover: the outputs in them are
-        # filled from the states of this cycle at the same phase
-        end_limit = max(0, (model.n_steps - stop - 1) // n_c)
-        could = 0 if js.settling or forced_jump == 0 else min(
-            end_limit, forced_jump if forced_jump is not None else int(GROWTH * js.last_jump + 1))
-        snapshots = filled.record(model, state, last, stop, could, observers, progress,
-                                  advance)
-        js.resolved_steps += stop - start
-        if stop - start < n_c or state.step >= model.n_steps:
-            break
-        if js.settling:
-            js.settling = False
-            continue
-        rates = [(s.wear_depth - b[0]) / window for s, b in zip(state.bodies, before)]
-        part_rates = [(p.depth - b[0]) / window for (_, p), b in zip(parts, before_parts)]
-        measures = ([jumps.measure(model, body, s, rate, start, window)
-                     for body, s, rate, start in zip(model.bodies, state.bodies, rates, starts)]
-                    if implicit else None)
-        middle = state.step / n_c - 0.5 * window
-        # (the counter's wear under a body vertex at the rate it settles
-        # to: a counter vertex catching up with the contact wears faster for
-        # a few cycles, and read as the contact's it relieved the bodies'
-        # jumps, and its own, by as much as it took; and its scatter is the
-        # noise the jumps extrapolate, the departure relaxing on its own)
-        increments = [None] * len(state.parts)
-        settled = [None] * len(state.parts)
-        stiffness = [None] * len(state.parts)     # per cycle, summed in the wear kernel
-        for k, ((j, part), rate) in enumerate(zip(parts, part_rates)):
-            increments[j] = settled[j] = rate
-            if implicit and len(part.stiffness):
-                stiffness[j] = part.stiffness / window
-                depth = before_parts[k][0] + 0.5 * window * rate
-                settled[j] = jumps.settled_rates(rate, stiffness[j], depth, middle,
-                                                 js.part_past[k])
-                js.part_past[k] = (js.part_past[k] + [(middle, depth, rate, stiffness[j])]
-                                   )[-HISTORY:]
-            js.part_noise[k] = _counter_noise(js, k, settled[j], middle)
-        logs = None
-        if parts and implicit:
-            logs = [jumps.pair_log(s, start) for s in state.bodies]
-            # (before the relaxation: the counter-part's wear under each
-            # body vertex relaxes its errors too, gamma_i)
-            for s, m, log in zip(state.bodies, measures, logs):
-                jumps.counter_relief(model, s, m, settled, state.time, log)
-        js.relax = _relaxation(measures)
-        _relax_resolved(js, measures, part_rates, window)
-        js.noisy = False
-        part_limit, part_which = float("inf"), None
-        if parts:
-            if forced_jump is None:
-                part_limit, part_which = _part_limit(model, parts, part_rates, js, measures,
-                                                     tolerance, end_limit, implicit,
-                                                     min(could, end_limit))
-        volumes = np.array([float((s.wear_volume - b[2]).sum()) / window
-                            for s, b in zip(state.bodies, before)])
-        js.volumes = (js.volumes + [(middle, volumes)])[-HISTORY:]
-        if implicit:
-            def keep(results, jump, forced=False):
-                return _keep_volume(model.bodies, measures, rates, state.bodies, before,
-                                    results, jump, window, js.volumes, forced)
+    return js
 
-            reaches = [jump_geometry.reach(model, body, s, state.time)
-                       for body, s in zip(model.bodies, state.bodies)]
 
-            def fits(results):
-                return jump_geometry.cut(model, state.bodies, before, rates, results, measures,
-                                         window, reaches)
+def _resolve(model, state, js, parts, implicit, advance, observers, progress, forced_jump):
+    """Resolve the next measurement's cycles (``js.window`` of them, or up
+    to the run's end) from ``state``, recording the last one's states for
+    the outputs a jump after it fills; return the :class:`_Measurement`."""
+    n_c = model.cycle_steps
+    start = js.cycle_start = state.step
+    before = [(s.wear_depth.copy(), s.vertices.copy(), s.wear_volume.copy(),
+               s.friction_work.copy()) for s in state.bodies]
+    before_parts = [(p.depth.copy(), p.volume.copy(), p.work.copy()) for _, p in parts]
+    # the penetrations at the cycle's start, to see each one's change at
+    # the same phase (the state at t = 0 is not yet placed in balance)
+    starts = ([jumps.start_depths(model, body, s) for body, s in zip(model.bodies,
+                                                                      state.bodies)]
+              if implicit and start > 0 else [None] * len(model.bodies))
+    for s in state.bodies:
+        s.load[:] = 0.0
+    for _, part in parts:
+        part.stiffness[:] = 0.0      # each counter vertex's, summed over the measurement
+    if implicit and parts:
+        for s in state.bodies:       # the pairs that wear the counters, over the measurement
+            jumps.start_log(s, start, js.window * n_c)
+    # a measurement averages the wear of ``window`` consecutive cycles
+    # (one, unless single cycles disagree): the last one is recorded for
+    # the outputs a jump after it fills
+    window = js.window
+    stop = min(start + window * n_c, model.n_steps)
+    last = max(start, stop - n_c)
+    if last > start:
+        advance(model, state, last, observers, progress)
+    # the cycles a jump after this one may cover: the outputs in them are
+    # filled from the states of this cycle at the same phase
+    end_limit = max(0, (model.n_steps - stop - 1) // n_c)
+    could = 0 if js.settling or forced_jump == 0 else min(
+        end_limit, forced_jump if forced_jump is not None else int(GROWTH * js.last_jump + 1))
+    snapshots = filled.record(model, state, last, stop, could, observers, progress,
+                              advance)
+    js.resolved_steps += stop - start
+    return _Measurement(start, before, before_parts, starts, window, stop, end_limit, could,
+                        snapshots)
 
-            jump, which, results = _choose_implicit(
-                measures, rates, js, end_limit, int(min(could, part_limit)), tolerance,
-                forced_jump, middle, [float(s.wear_depth.max(initial=0.0)) for s in state.bodies],
-                keep, fits)
-            if part_limit < could and (which == "growth" or part_limit < 1):
-                which = part_which       # the counter-parts bounded it (or refused it)
+
+def _measure(model, state, js, parts, implicit, cycle):
+    """Read the resolved measurement ``cycle`` into its rates: each body's
+    and worn counter-part's wear per cycle, the bodies' implicit measures,
+    the rates the counter-parts settle to and their noise; relax the errors
+    so far over its cycles (:func:`meshwear.longrun.jump_errors._relax_resolved`)."""
+    n_c = model.cycle_steps
+    window, before, before_parts = cycle.window, cycle.before, cycle.before_parts
+    start, starts = cycle.start, cycle.starts
+    rates = [(s.wear_depth - b[0]) / window for s, b in zip(state.bodies, before)]
+    part_rates = [(p.depth - b[0]) / window for (_, p), b in zip(parts, before_parts)]
+    measures = ([jumps.measure(model, body, s, rate, start, window)
+                 for body, s, rate, start in zip(model.bodies, state.bodies, rates, starts)]
+                if implicit else None)
+    middle = state.step / n_c - 0.5 * window
+    # (the counter's wear under a body vertex at the rate it settles
+    # to: a counter vertex catching up with the contact wears faster for
+    # a few cycles, and read as the contact's it relieved the bodies'
+    # jumps, and its own, by as much as it took; and its scatter is the
+    # noise the jumps extrapolate, the departure relaxing on its own)
+    increments = [None] * len(state.parts)
+    settled = [None] * len(state.parts)
+    stiffness = [None] * len(state.parts)     # per cycle, summed in the wear kernel
+    for k, ((j, part), rate) in enumerate(zip(parts, part_rates)):
+        increments[j] = settled[j] = rate
+        if implicit and len(part.stiffness):
+            stiffness[j] = part.stiffness / window
+            depth = before_parts[k][0] + 0.5 * window * rate
+            settled[j] = jumps.settled_rates(rate, stiffness[j], depth, middle,
+                                             js.part_past[k])
+            js.part_past[k] = (js.part_past[k] + [(middle, depth, rate, stiffness[j])]
+                               )[-HISTORY:]
+        js.part_noise[k] = _counter_noise(js, k, settled[j], middle)
+    logs = None
+    if parts and implicit:
+        logs = [jumps.pair_log(s, start) for s in state.bodies]
+        # (before the relaxation: the counter-part's wear under each
+        # body vertex relaxes its errors too, gamma_i)
+        for s, m, log in zip(state.bodies, measures, logs):
+            jumps.counter_relief(model, s, m, settled, state.time, log)
+    js.relax = _relaxation(measures)
+    _relax_resolved(js, measures, part_rates, window)
+    js.noisy = False
+    cycle.rates, cycle.part_rates, cycle.measures = rates, part_rates, measures
+    cycle.middle = middle
+    cycle.increments, cycle.settled, cycle.stiffness = increments, settled, stiffness
+
+
+def _choose(model, state, js, parts, implicit, tolerance, cycle, forced_jump):
+    """The jump after measurement ``cycle``: its cycles, the bound that set
+    it, and per body its ``(wear, move, error)``. Implicit:
+    :func:`meshwear.longrun.jump_choice._choose_implicit`, the volume kept
+    (:func:`meshwear.longrun.jump_volume._keep_volume`) and the mesh's
+    bounds (:func:`meshwear.longrun.jump_geometry.cut`); explicit:
+    :func:`meshwear.longrun.jump_choice.choose_jump` per body and the fold
+    bound; either within the worn counter-parts' bound
+    (:func:`meshwear.longrun.jump_choice._part_limit`)."""
+    window, before, rates, measures = cycle.window, cycle.before, cycle.rates, cycle.measures
+    end_limit, could, middle = cycle.end_limit, cycle.could, cycle.middle
+    part_limit, part_which = float("inf"), None
+    if parts:
+        if forced_jump is None:
+            part_limit, part_which = _part_limit(model, parts, cycle.part_rates, js, measures,
+                                                 tolerance, end_limit, implicit,
+                                                 min(could, end_limit))
+    volumes = np.array([float((s.wear_volume - b[2]).sum()) / window
+                        for s, b in zip(state.bodies, before)])
+    js.volumes = (js.volumes + [(middle, volumes)])[-HISTORY:]
+    if implicit:
+        def keep(results, jump, forced=False):
+            return _keep_volume(model.bodies, measures, rates, state.bodies, before,
+                                results, jump, window, js.volumes, forced)
+
+        reaches = [jump_geometry.reach(model, body, s, state.time)
+                   for body, s in zip(model.bodies, state.bodies)]
+
+        def fits(results):
+            return jump_geometry.cut(model, state.bodies, before, rates, results, measures,
+                                     window, reaches)
+
+        jump, which, results = _choose_implicit(
+            measures, rates, js, end_limit, int(min(could, part_limit)), tolerance,
+            forced_jump, middle, [float(s.wear_depth.max(initial=0.0)) for s in state.bodies],
+            keep, fits)
+        if part_limit < could and (which == "growth" or part_limit < 1):
+            which = part_which       # the counter-parts bounded it (or refused it)
+    else:
+        jump, which = end_limit, "end"
+        if forced_jump is not None:
+            jump, which = min(end_limit, forced_jump), "forced"
         else:
-            jump, which = end_limit, "end"
-            if forced_jump is not None:
-                jump, which = min(end_limit, forced_jump), "forced"
-            else:
-                for body, s, rate, previous in zip(model.bodies, state.bodies, rates, js.rate):
-                    j, w = choose_jump(rate, previous, js.gap, penetration(model, body, s),
-                                       tolerance, js.last_jump, end_limit)
-                    if j < jump:
-                        jump, which = j, w
-            jump = min(jump, could)
-            if forced_jump is None and jump > 0:
-                # fold: the extrapolated moves are the cycle's times the
-                # jump, so the share of one cycle allowed is the cycles
-                cycle = [(rate, 0.0, None) for rate in rates]
-                cut = jump_geometry.cut(model, state.bodies, before, rates, cycle, None, window)
-                if cut is not None and cut[1] < jump:
-                    which, jump = cut[0], int(np.floor(cut[1]))
-            results = [(jump * rate, 0.0, _slope_error(rate, previous, js.gap, jump))
-                       for rate, previous in zip(rates, js.rate)]
-        if jump > 0:
-            if not implicit:
-                for error, (_, _, estimate) in zip(js.error, results):
-                    error += estimate
-            js.limits[which] = js.limits.get(which, 0) + 1
-            js.last_limit = which
-            factors = None
-            if parts and implicit:
-                # (before the jump moves the bodies: the feet at the cycle's end)
-                factors = jumps.counter_factors(model, state, measures, results, rates, jump,
-                                                increments, state.time, stiffness, settled)
-            spans = _jump(model, state, before, rates, jump, results, measures, window)
-            share = None
-            if factors is not None:
-                # (the jump has moved the bodies' arrays on: the measurement's
-                # volume is from before it to the jump's start)
-                cycle = sum(float((span["wear_volume"][0] - b[2]).sum()) for span, b in
-                            zip(spans, before)) / window
-                jumped = sum(float((span["wear_volume"][1] - span["wear_volume"][0]).sum())
-                             for span in spans)
-                share = jumped / cycle if cycle > 0.0 else None
-            part_spans = _jump_parts(model, parts, before_parts, part_rates, js, jump, factors,
-                                     window, share)
-            before_fill = time.perf_counter()
-            js.filled_outputs += filled.write(
-                model, state, stop, jump, snapshots, spans, observers, check, part_spans,
-                _progress(measures, results, jump) if implicit and forced_jump is None
-                else None)
-            js.fill_seconds += time.perf_counter() - before_fill
-            js.jumps += 1
-            js.taken.append((stop / n_c, jump, which))
-            js.settling = not model.quasi_static
-        js.last_jump = _grows_from(jump, which, js.last_jump)
-        if jump == 0:
-            js.last_limit = which        # why none was taken (the progress line says)
-        js.rate = rates
-        js.part_rate = part_rates
-        if implicit:
-            js.alpha = []
-            for m, rate in zip(measures, rates):
-                alpha = np.zeros(len(rate))
-                alpha[m.index] = np.where(m.mean > 0.0, m.alpha, 0.0)
-                js.alpha.append(alpha)
-        js.history = (js.history + [(middle, js.alpha if implicit else None,
-                                      [settled[j] for j, _ in parts])])[1 - HISTORY:]
-        following = window
-        if (forced_jump is None and which in NOISY and jump < 2 * window
-                and window < MAX_WINDOW and js.noisy):
-            # single measurements disagree by more than the jumps they allow
-            # (a vertex at a contact's edge touched every other cycle, a
-            # flank switching between two rates): average over more cycles,
-            # and measure the noise and the drift again at that window (not
-            # where the errors of the jumps before fill the tolerance: the
-            # resolved cycles relax them)
-            following = js.window = 2 * window
-            js.history = []
-            js.volumes = []
-        # cycles between the middles of this measurement and the next
-        js.gap = jump + 0.5 * (window + following) + (1.0 if js.settling else 0.0)
-        if checkpoint is not None:
-            checkpoint(model, state)
-    return state
+            for body, s, rate, previous in zip(model.bodies, state.bodies, rates, js.rate):
+                j, w = choose_jump(rate, previous, js.gap, penetration(model, body, s),
+                                   tolerance, js.last_jump, end_limit)
+                if j < jump:
+                    jump, which = j, w
+        jump = min(jump, could)
+        if forced_jump is None and jump > 0:
+            # fold: the extrapolated moves are the cycle's times the
+            # jump, so the share of one cycle allowed is the cycles
+            per_cycle = [(rate, 0.0, None) for rate in rates]
+            cut = jump_geometry.cut(model, state.bodies, before, rates, per_cycle, None, window)
+            if cut is not None and cut[1] < jump:
+                which, jump = cut[0], int(np.floor(cut[1]))
+        results = [(jump * rate, 0.0, _slope_error(rate, previous, js.gap, jump))
+                   for rate, previous in zip(rates, js.rate)]
+    return jump, which, results
+
+
+def _take(model, state, js, parts, implicit, cycle, jump, which, results, observers, check,
+          forced_jump):
+    """Take the chosen jump of ``jump`` cycles (``which`` bound set it;
+    ``results`` per body its wear, move and error) after measurement
+    ``cycle``: add its errors, move the bodies and the worn counter-parts
+    on (:mod:`meshwear.longrun.extrapolate`), and fill the outputs inside
+    it (:func:`meshwear.output.filled.write`)."""
+    n_c = model.cycle_steps
+    window, before, rates, measures = cycle.window, cycle.before, cycle.rates, cycle.measures
+    if not implicit:
+        for error, (_, _, estimate) in zip(js.error, results):
+            error += estimate
+    js.limits[which] = js.limits.get(which, 0) + 1
+    js.last_limit = which
+    factors = None
+    if parts and implicit:
+        # (before the jump moves the bodies: the feet at the cycle's end)
+        factors = jumps.counter_factors(model, state, measures, results, rates, jump,
+                                        cycle.increments, state.time, cycle.stiffness,
+                                        cycle.settled)
+    spans = _jump(model, state, before, rates, jump, results, measures, window)
+    share = None
+    if factors is not None:
+        # (the jump has moved the bodies' arrays on: the measurement's
+        # volume is from before it to the jump's start)
+        volume = sum(float((span["wear_volume"][0] - b[2]).sum()) for span, b in
+                     zip(spans, before)) / window
+        jumped = sum(float((span["wear_volume"][1] - span["wear_volume"][0]).sum())
+                     for span in spans)
+        share = jumped / volume if volume > 0.0 else None
+    part_spans = _jump_parts(model, parts, cycle.before_parts, cycle.part_rates, js, jump,
+                             factors, window, share)
+    before_fill = time.perf_counter()
+    js.filled_outputs += filled.write(
+        model, state, cycle.stop, jump, cycle.snapshots, spans, observers, check, part_spans,
+        _progress(measures, results, jump) if implicit and forced_jump is None
+        else None)
+    js.fill_seconds += time.perf_counter() - before_fill
+    js.jumps += 1
+    js.taken.append((cycle.stop / n_c, jump, which))
+    js.settling = not model.quasi_static
+
+
+def _remember(js, parts, implicit, cycle, jump, which, forced_jump):
+    """Keep in ``js`` what the measurement after ``cycle`` grows from: the
+    jump ``jump`` (0: none) that ``which`` bound set, the rates, the
+    history the drift and the noise are read from, the window (doubled
+    where single measurements are too noisy for the jumps they allow) and
+    the cycles between this measurement's middle and the next's."""
+    window, measures, rates = cycle.window, cycle.measures, cycle.rates
+    js.last_jump = _grows_from(jump, which, js.last_jump)
+    if jump == 0:
+        js.last_limit = which        # why none was taken (the progress line says)
+    js.rate = rates
+    js.part_rate = cycle.part_rates
+    if implicit:
+        js.alpha = []
+        for m, rate in zip(measures, rates):
+            alpha = np.zeros(len(rate))
+            alpha[m.index] = np.where(m.mean > 0.0, m.alpha, 0.0)
+            js.alpha.append(alpha)
+    js.history = (js.history + [(cycle.middle, js.alpha if implicit else None,
+                                  [cycle.settled[j] for j, _ in parts])])[1 - HISTORY:]
+    following = window
+    if (forced_jump is None and which in NOISY and jump < 2 * window
+            and window < MAX_WINDOW and js.noisy):
+        # single measurements disagree by more than the jumps they allow
+        # (a vertex at a contact's edge touched every other cycle, a
+        # flank switching between two rates): average over more cycles,
+        # and measure the noise and the drift again at that window (not
+        # where the errors of the jumps before fill the tolerance: the
+        # resolved cycles relax them)
+        following = js.window = 2 * window
+        js.history = []
+        js.volumes = []
+    # cycles between the middles of this measurement and the next
+    js.gap = jump + 0.5 * (window + following) + (1.0 if js.settling else 0.0)
 
 
 def _grows_from(jump, which, last):
