@@ -34,7 +34,7 @@ from scipy.optimize import brentq  # noqa: E402
 
 from common import replace_section, timed_run  # noqa: E402
 from meshwear.scene.format import load_scene  # noqa: E402
-from meshwear.longrun.wear import error_estimate  # noqa: E402
+from meshwear.longrun.jump_errors import error_estimate  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 ANALYTIC = ROOT / "examples" / "block_on_ring.toml"

@@ -32,7 +32,7 @@ from common import replace_section  # noqa: E402
 from meshwear.scene.format import load_scene  # noqa: E402
 from meshwear.model.build import build_model, initial_state  # noqa: E402
 from meshwear.step.simulate import run  # noqa: E402
-from meshwear.longrun.wear import error_estimate  # noqa: E402
+from meshwear.longrun.jump_errors import error_estimate  # noqa: E402
 
 TOLERANCES = (1e-1, 1e-2, 1e-3, 1e-4)
 FRETTING = ROOT / "examples" / "long" / "sphere_fretting_1e5.toml"

@@ -17,7 +17,7 @@ from meshwear.step.estimate import _cycles_left, _forecast, _jump_at, _trend_ran
 from meshwear.model.build import build_model, initial_state
 from meshwear.scene.format import load_scene
 from meshwear.step.simulate import run
-from meshwear.longrun.wear import GROWTH
+from meshwear.longrun.jump_choice import GROWTH
 
 
 # ---------------------------------------------------------------- the rule, in closed form

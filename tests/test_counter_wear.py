@@ -905,7 +905,8 @@ def test_counter_noise_is_the_scatter_about_the_rates_drift():
     however long the jumps between the measurements) is no noise; a vertex
     touched every other cycle, or whose rate scatters, is; fewer than three
     measurements, not yet measured."""
-    from meshwear.longrun.wear import JumpState, _counter_noise
+    from meshwear.longrun.wear import JumpState
+    from meshwear.longrun.jump_errors import _counter_noise
 
     base = np.array([1.0e-9, 2.0e-9, 0.0])
     drifting = [(t, None, [base * (1.0 - 0.002 * t)]) for t in (10.0, 50.0, 51.0)]
@@ -930,7 +931,7 @@ def test_a_counter_vertex_the_contact_reaches_settles_without_noise():
     fretting example: a flat vertex at the scar's corner given a noise 1.6
     times its rate, 40 times what eight resolved cycles in a row scatter,
     held the jumps). Independent scatter is still counted."""
-    from meshwear.longrun.wear import _fit, _local_scatter
+    from meshwear.longrun.jump_errors import _fit, _local_scatter
 
     t = 4000.0 + 17.0 * np.arange(8)
     settling = 1e-9 * (1.0 - np.exp(-(t - 3990.0) / 40.0))
@@ -951,7 +952,7 @@ def test_an_error_the_contact_has_left_over_the_tolerance_does_not_refuse_every_
     that tolerance: a jump that adds nothing to it passes, one that adds
     its noise is bounded, and a wearing vertex over it still refuses (the
     resolved cycles relax it)."""
-    from meshwear.longrun.wear import _noise_bound
+    from meshwear.longrun.jump_errors import _noise_bound
 
     tol, deepest, fastest, relax = 0.01, 3.2e-6, 5e-10, 300.0
     over = (1.1 * tol * deepest) ** 2

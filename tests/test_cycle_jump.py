@@ -10,7 +10,9 @@ import cases
 from meshwear.model.build import build_model, initial_state
 from meshwear.scene.format import load_scene
 from meshwear.step.simulate import run, run_scene
-from meshwear.longrun.wear import GROWTH, THETA, _grows_from, choose_jump, error_estimate
+from meshwear.longrun.jump_choice import GROWTH, THETA, choose_jump
+from meshwear.longrun.jump_errors import error_estimate
+from meshwear.longrun.wear import _grows_from
 
 
 # ---------------------------------------------------------------- controller
@@ -386,7 +388,8 @@ def test_an_implicit_jump_s_errors_hold_its_drift_and_relax_as_the_contact_does(
     and their stiffness-weighted mean, the drift's signed, which the relief
     does not take off, is kept apart (docs/model.md, "Long durations")."""
     from meshwear.longrun.jumps import BodyJump, implicit
-    from meshwear.longrun.wear import JumpState, _choose_implicit
+    from meshwear.longrun.wear import JumpState
+    from meshwear.longrun.jump_choice import _choose_implicit
 
     k, p = 3, 1e-6
     alpha = np.full(k, 1e-3)                        # wear per cycle per unit penetration
@@ -515,7 +518,7 @@ def test_a_jump_keeps_its_volume_along_the_change_of_every_alpha_alike():
     wore (scaling every vertex's wear there left the block-on-ring scar's
     edge 4.2 % of its depth off the ring's arc)."""
     from meshwear.longrun.jumps import BodyJump, single_step
-    from meshwear.longrun.wear import _volume_direction
+    from meshwear.longrun.jump_volume import _volume_direction
 
     p = np.array([1.0, 1.2, 0.8, 1.1]) * 1e-6
     c = np.full(4, 1e6)

@@ -274,7 +274,7 @@ def _cycles_left(position, total, window, settle, jump, trend):
     (``GROWTH J + 1`` from the last ``jump``, up to ``trend``'s ``a p^b``,
     at least one cycle; None: growth alone, "none": no jump) that leaves
     the run's last cycle resolved, and ``settle`` cycles after it."""
-    from ..longrun.wear import GROWTH
+    from ..longrun.jump_choice import GROWTH
 
     cycles = 0.0
     if trend == "none":
