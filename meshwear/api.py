@@ -156,7 +156,7 @@ def run(scene, *, out=None, progress=None, vertex_history=False, check_dt=True):
     ------
     meshwear.scene.SceneError
         Bad input (one line naming the key).
-    meshwear.simulate.NumericalError
+    meshwear.step.simulate.NumericalError
         The run became numerically invalid (the files written so far stay valid).
     """
     from .model.build import build_model, check_time_step, initial_state

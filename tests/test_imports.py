@@ -179,10 +179,9 @@ def _code_map():
             folder = words[0]
         elif depth == 2:
             folder = ""
-        names = re.findall(r"\b([a-z_]+\.py)\b", line.split("  ", 2)[-1] if depth == 4 else line)
-        if depth == 4:
-            names = re.findall(r"\b([a-z_]+\.py)\b", line.strip().split("   ")[0])
-        named.update(folder + n for n in names)
+        # the file names come first on a line, three spaces before what they do
+        files = line.strip().split("   ")[0]
+        named.update(folder + n for n in re.findall(r"\b([a-z_]+\.py)\b", files))
     return named
 
 

@@ -1,6 +1,6 @@
 """Fields of a half-space patch's grid read at its vertices (docs/model.md, "In a run").
 
-The elastic solve (:mod:`meshwear.halfspace`) gives tractions on a regular
+The elastic solve (:mod:`meshwear.contact.halfspace`) gives tractions on a regular
 grid of cells; the vertices of the body's mesh need a pressure, a force, a
 shear and a friction energy each. A vertex reads a field at its point on the
 contact plane, bilinearly between the four cell centres around it

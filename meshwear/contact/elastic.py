@@ -1,7 +1,7 @@
 """The elastic half-space contact model in a run (docs/model.md, "Elastic half-space").
 
 With ``[contact] model = "half-space"`` a quasi-static body's contact
-forces come from the elastic solve of :mod:`meshwear.halfspace` instead of
+forces come from the elastic solve of :mod:`meshwear.contact.halfspace` instead of
 a spring per vertex. At each step, for each body and its counter-surface:
 
 1. Gaps. The body is placed on its path; each vertex facing the surface
@@ -11,7 +11,7 @@ a spring per vertex. At each step, for each body and its counter-surface:
    regular grid in the tangent plane (cells of about one vertex's
    contact area, axes fixed to the body, the first along its path's
    stroke). The vertices' Delaunay triangles interpolate the gaps onto the
-   cells, linearly. Back on the vertices (:mod:`meshwear.cellfields`),
+   cells, linearly. Back on the vertices (:mod:`meshwear.contact.cellfields`),
    the grid's fields are read at each vertex's point, bilinearly between
    the four cell centres around it: its pressure; its force is that
    pressure times its contact area, all scaled alike so that the vertices
@@ -27,7 +27,7 @@ a spring per vertex. At each step, for each body and its counter-surface:
 4. Tangential. A translation along the grid's first axis, the same at
    every point (a fretting stroke, a straight slide), is Cattaneo-Mindlin
    partial slip with Mindlin and Deresiewicz's reversals, solved at the
-   stroke's displacement (:func:`meshwear.halfspace.shear_at_shift`) on the
+   stroke's displacement (:func:`meshwear.contact.halfspace.shear_at_shift`) on the
    window of pressed cells (merged f x f where wider than
    :data:`meshwear.contact.elastic_patch.SHEAR_CELLS`): stick and slip
    per cell, each cell's slip and friction energy from its shear and the
@@ -105,7 +105,7 @@ class HalfSpace:
 
 def step(model, body, s, t, before, at_rest=False):
     """One quasi-static step of ``body`` (state ``s``) at ``t`` with the
-    elastic half-space, after :func:`meshwear.simulate._quasi_static_step`
+    elastic half-space, after :func:`meshwear.step.simulate._quasi_static_step`
     placed it on its path (``before``: its position at the step's start)
     and updated its surfaces: normal and tangential tractions, the load
     balance, wear. Fills the same state arrays as the Winkler kernel. ``at_rest``:
@@ -328,7 +328,7 @@ def vertex_pressure(s):
 
 def counter_pairs(s):
     """Per slot, the (contact state, normal force) a worn counter-surface
-    wears by after a half-space step (:func:`meshwear.model.wear_counters`):
+    wears by after a half-space step (:func:`meshwear.step.counters.wear_counters`):
     the vertices that dissipated energy slip, each with the force whose
     Coulomb slip at its speed dissipates that energy; the others nothing."""
     patch = s.elastic
@@ -377,7 +377,7 @@ def describe(model, state):
 
 
 def equivalent_depth(model, body, s, index, depth, area):
-    """The penetrations a cycle jump reasons with (:func:`meshwear.jumps.contact_geometry`)
+    """The penetrations a cycle jump reasons with (:func:`meshwear.longrun.jumps.contact_geometry`)
     for a half-space contact: a loaded vertex's force over its stiffness on
     the equivalent Winkler foundation, ``N_i / (K A_i)``; an unloaded one in
     the patch, minus its gap after the surfaces deformed (the rigid overlap

@@ -36,7 +36,7 @@ SHEAR_CELLS = 64
 
 @dataclass(eq=False)
 class Patch:
-    """One body's solve, kept from step to step (:mod:`meshwear.elastic`)."""
+    """One body's solve, kept from step to step (:mod:`meshwear.contact.elastic`)."""
 
     e1: np.ndarray                       # (3,) world: the grid's first axis
     e2: np.ndarray
@@ -250,7 +250,7 @@ def _window(lo, hi, size, f):
 def _new_pressure(patch, solution, heights, areas):
     """Take the ``solution`` of the normal problem on ``heights`` (the
     patch's vertices' gaps; ``areas`` their contact areas): the vertices'
-    pressure at their points and their forces (:mod:`meshwear.cellfields`), the
+    pressure at their points and their forces (:mod:`meshwear.contact.cellfields`), the
     loaded vertices, the window of the tangential problem."""
     patch.pressure = solution.traction
     patch.heights = heights.copy()

@@ -149,7 +149,7 @@ def balance_offset(body_vertices, pose, axis, planes, vertex_planes, active, are
     """Offset ``z`` (m) along ``axis`` at which the contact normal forces on
     the body at ``pose`` add up to ``load`` (N) along ``axis``; with a
     non-empty ``scale`` (n,), the contact stiffness of vertex ``i`` times
-    ``scale[i]`` (a wear jump: :mod:`meshwear.wear`).
+    ``scale[i]`` (a wear jump: :mod:`meshwear.longrun.wear`).
 
     Returns NaN when no contact can push the way ``load`` needs (no plane
     faces the body along the axis, or the load pulls it away from every
@@ -222,7 +222,7 @@ def solve(breakpoint, weight, count, load, guess, bound):
 @njit(cache=True)
 def implicit_step(jump, alpha, gamma, member, touched, beta, stiffness, depth, now, load, guided):
     """One backward-Euler step of ``jump`` cycles of a body's jump
-    (:func:`meshwear.jumps.implicit`; docs/model.md, "Long durations"), from
+    (:func:`meshwear.longrun.jumps.implicit`; docs/model.md, "Long durations"), from
     the penetrations at the end of the cycle ``depth`` and while in contact
     ``now`` (k,): its wear (k,), the move ``z`` along the free axis (0
     unless ``guided``, or when no pair carries the load) and the

@@ -272,7 +272,7 @@ def wear_counter(body_vertices, pose, active, area, law, contact_state, normal_f
     run).
 
     While ``log_count[1]`` is 1 each pair's share of each counter vertex is
-    logged, for the jumps (:func:`meshwear.jumps.pair_log`): row
+    logged, for the jumps (:func:`meshwear.longrun.jumps.pair_log`): row
     ``log_count[0]`` of ``log_index`` (per-vertex surface ``surface``, the
     body vertex, the counter vertex) and of ``log_value`` (the pair's
     normal force times its weight on the counter vertex, N);

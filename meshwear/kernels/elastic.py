@@ -1,5 +1,5 @@
 """The gaps of a body's vertices against its one counter-surface, for the
-half-space model (:mod:`meshwear.elastic`): one pass over the active set.
+half-space model (:mod:`meshwear.contact.elastic`): one pass over the active set.
 
 Arrays as in :mod:`meshwear.kernels.contact`; the outputs, per active
 vertex ``k`` (vertex ``active[k]``): ``gap`` (m, along the normal of the

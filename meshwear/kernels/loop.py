@@ -1,6 +1,6 @@
 """The compiled step loop: many steps of one body without returning to Python.
 
-:func:`advance_body` runs the steps of :func:`meshwear.simulate.step_body`
+:func:`advance_body` runs the steps of :func:`meshwear.step.simulate.step_body`
 (the Python reference it must match to the last bit) for one worn body, from
 step ``k`` up to ``stop``, and hands back to Python whatever it does not do
 itself: an active-set refresh (before the step that needs it, having changed
@@ -8,10 +8,10 @@ nothing of that step, or, in the quasi-static mode, after the settling move
 of a step, for Python to finish it), a load nothing carries and a counter
 vertex worn too deep. Bodies do not act on one another (only on
 counter-surfaces), so each runs on its own between two output times, unless
-a counter-surface they share wears (then :mod:`meshwear.stepper` steps them
+a counter-surface they share wears (then :mod:`meshwear.step.stepper` steps them
 in turn, one step each).
 
-Arguments are grouped in tuples (:mod:`meshwear.stepper` packs them):
+Arguments are grouped in tuples (:mod:`meshwear.step.stepper` packs them):
 
 body
     ``vertices, pose, area, law, wear_direction, contact_state, tangential,
@@ -19,7 +19,7 @@ body
     vertex_planes, hint, active, active_wear, cull, distance, load`` (the
     arrays of :class:`meshwear.model.BodyState` and its model; ``load`` (5, n)
     adds up each vertex's total normal force, its square and its vector over
-    the steps, or is (2, 0): :data:`meshwear.jumps.LOAD_ROWS`) and
+    the steps, or is (2, 0): :data:`meshwear.longrun.jumps.LOAD_ROWS`) and
     ``radius`` (m).
 motion
     ``kind`` and ``params`` (:mod:`meshwear.kernels.rigid`), the path
@@ -96,7 +96,7 @@ def _fill(body, planes, surfaces, t, buffer, rotation, frame):
 def _touch(body, plane_array):
     """One step of the contact kernel; the normal forces, their squares and
     their vectors (along each slot's normal) added to ``load``
-    (:data:`meshwear.jumps.LOAD_ROWS`)."""
+    (:data:`meshwear.longrun.jumps.LOAD_ROWS`)."""
     (vertices, pose, area, law, wear_direction, contact_state, tangential, normal_force,
      friction_work, wear_depth, wear_volume, wrench, vertex_planes, hint, active, active_wear,
      cull, distance, load, radius, depth_limit, impact_room, _, _, _) = body

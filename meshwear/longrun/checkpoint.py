@@ -272,7 +272,7 @@ def load(path, model, state):
 
 
 class Checkpointer:
-    """Observer-side hook for :func:`meshwear.simulate.run`: saves the state at
+    """Observer-side hook for :func:`meshwear.step.simulate.run`: saves the state at
     most every ``every`` seconds of wall time (0: at every opportunity)."""
 
     def __init__(self, out_dir, every, wall_before=0.0):

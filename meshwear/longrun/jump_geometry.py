@@ -19,7 +19,7 @@ fold
     :data:`FOLD` of the way to folding over: the jump's displacements, the
     whole of them over :data:`FOLD`, keep every such face's area along its
     unworn normal positive (what the run's check,
-    :func:`meshwear.simulate.check`, asks of every worn face).
+    :func:`meshwear.step.simulate.check`, asks of every worn face).
 """
 
 import numpy as np
@@ -69,7 +69,7 @@ def displacement(body, s, vertices0, rate, wear, normal, window=1):
     ``rate`` (n,) per cycle): its cycle's move scaled by its jump's
     ``wear`` (n,) over its cycle's wear, or, brought into contact by the
     jump (``normal`` (n, 3) world, or None: none are), its wear along its
-    wear direction (:func:`meshwear.wear._jump` moves them so)."""
+    wear direction (:func:`meshwear.longrun.wear._jump` moves them so)."""
     factor = np.zeros(len(rate))
     wearing = rate > 0.0
     factor[wearing] = wear[wearing] / (rate[wearing] * window)
@@ -126,7 +126,7 @@ def _first_root(a, b, c):
 
 def cut(model, states, before, rates, results, measures, window, reaches=None):
     """Whether a jump's ``results`` (per body ``(wear, move, error)``,
-    :func:`meshwear.wear._choose_implicit`'s) stay within what the mesh
+    :func:`meshwear.longrun.jump_choice._choose_implicit`'s) stay within what the mesh
     they move allows: None, or the bound they break and the share of the
     jump it allows (the move and the vertices' moves scaled down alike).
     ``reach``: a guided body's move along its axis past ``reaches`` (per
@@ -134,7 +134,7 @@ def cut(model, states, before, rates, results, measures, window, reaches=None):
     way to folding over. ``states``: the bodies at the jump's start,
     ``before`` their arrays at the start of the measurement of ``window``
     cycles in which they wore ``rates`` (per body (n,), m per cycle);
-    ``measures`` their :class:`meshwear.jumps.BodyJump`, or None (explicit:
+    ``measures`` their :class:`meshwear.longrun.jumps.BodyJump`, or None (explicit:
     no vertex comes into contact)."""
     worst = None
     for k, (body, s, b, rate, (wear, move, _)) in enumerate(

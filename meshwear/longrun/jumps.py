@@ -30,7 +30,7 @@ the cycle, ``r_c,i = gamma_i pbar_i`` (linear in the pressure alike), takes
 off its penetration with its own: ``alpha_i`` becomes ``alpha_i + gamma_i``
 in the relief above, while the vertex itself wears ``J alpha_i`` times its
 relieved penetration (:func:`counter_relief`; the counter-part's own wear is
-extrapolated in :mod:`meshwear.wear`).
+extrapolated in :mod:`meshwear.longrun.wear`).
 
 A jump is taken as one step of ``J``, two of ``J / 2`` and four of ``J / 4``
 (each from the penetrations the one before leaves) and advances with their

@@ -187,7 +187,7 @@ def run_cycle_jump(model, state, advance, check, observers=(), progress=None, ch
                    forced_jump=None):
     """Run ``state`` to the end of ``model``'s duration, jumping over cycles.
 
-    The step loop is the caller's (:func:`meshwear.simulate.run` passes its
+    The step loop is the caller's (:func:`meshwear.step.simulate.run` passes its
     own): ``advance(model, state, stop, observers, progress)`` resolves
     steps up to ``stop`` writing the outputs due, and
     ``check(model, state, face_normals)`` refuses an invalid state.

@@ -17,7 +17,7 @@ counter-surfaces, friction, wear and the evolving geometry. A step of
    then its kinematics there, which place the parts for the next step.
 
 :class:`Mechanism` is one implementation of the dynamics seam
-(:mod:`meshwear.dynamics`; meshwear's own motions are the other): poses and
+(:mod:`meshwear.motion.dynamics`; meshwear's own motions are the other): poses and
 velocities out (:meth:`Mechanism.place`), wrenches in (:meth:`Mechanism.push`).
 A part on a mechanism body has the motion kind ``FIXED`` in the compiled
 loop, so the loop never moves it between two placings.

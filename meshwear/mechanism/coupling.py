@@ -41,7 +41,7 @@ class Coupling:
 
     def advance(self, model, state, until, step_bodies):
         """Steps from ``state.step`` up to ``until`` of the mechanism and every
-        body (:mod:`meshwear.dynamics`): in the compiled loop
+        body (:mod:`meshwear.motion.dynamics`): in the compiled loop
         (:func:`meshwear.kernels.mechanism.advance_mechanism`), or a step at
         a time through Python where MuJoCo's library cannot be called from
         it. Returns None, or ``(step, code, body, report)``."""

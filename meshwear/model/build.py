@@ -260,7 +260,7 @@ def _refuse_before_refining(scene, built, unrefined, loaded=None):
     placed inside a surface, and a surface's resolution too fine for this
     machine from the bodies' coarse meshes (their vertices are among the
     refined ones', and the refined ones lie near the faces their resolution
-    refines: :func:`meshwear.reach.refuse_early`), are refused without
+    refines: :func:`meshwear.model.reach.refuse_early`), are refused without
     the bodies' refinement first (a turning shaft's 80 000 faces take
     seconds). The deep-start check is made again once the parts are refined
     (their facets' sag)."""

@@ -2,7 +2,7 @@
 "resolution"): a body's where it can meet a surface, a mesh surface's where
 a body can reach it over the run.
 
-Each selection is handed to :func:`meshwear.remesh.refine`, with what it
+Each selection is handed to :func:`meshwear.geometry.remesh.refine`, with what it
 surely refines (``surely``: faces; ``within``: points), so that a resolution
 too fine for the machine is refused from an estimate before the passes that
 would fill the memory (docs/outputs.md, "Limits checked before any work").
@@ -49,7 +49,7 @@ def faces_to_refine(scene, body, vertices, faces, surface_set):
     start (its path's displacement included); all of one that turns.
 
     With ``resolution_reach`` given, the faces within it, chosen anew at
-    each pass of the refinement (:func:`meshwear.remesh.refine`) on the
+    each pass of the refinement (:func:`meshwear.geometry.remesh.refine`) on the
     part's true surface (a primitive's vertices put on it, each face's sag
     allowed for): the faces of a coarse sphere are a millimetre wide, and
     taken whole a 10 mm ball with a 20 µm reach had 200 000 vertices refined
@@ -89,7 +89,7 @@ def surface_faces_to_refine(scene, surface, bodies, periods, resolution):
 
     The selection's ``within(points)`` says which points of the surface lie
     within that reach: every face holding one is refined whatever the
-    passes, the area :func:`meshwear.remesh.refine` estimates its size from.
+    passes, the area :func:`meshwear.geometry.remesh.refine` estimates its size from.
     The same estimate from the coarsest samples refuses too fine a
     resolution before the finer ones are taken.
 

@@ -61,7 +61,7 @@ class BodyModel:
         :data:`meshwear.model.build.IMPACT_DEPTH` of its thinnest extent; 0
         for bodies placed by their path.
     refinement : dict or None
-        What ``resolution`` did (:func:`meshwear.remesh.refine_part`).
+        What ``resolution`` did (:func:`meshwear.geometry.remesh.refine_part`).
     margin : float
         Its default active-set margin (m), used where ``contact.margin`` is
         not given, and why (``margin_reason``):
@@ -119,7 +119,7 @@ class Model:
     extent: float = 1.0
     #: the MuJoCo mechanism the riders move with (:mod:`meshwear.mechanism`), or None
     mechanism: object = None
-    #: the half-space contact's constants (:class:`meshwear.elastic.HalfSpace`),
+    #: the half-space contact's constants (:class:`meshwear.contact.elastic.HalfSpace`),
     #: or None: the Winkler foundation of ``law``
     elastic: object = None
     #: what set ``dt``: "run.dt", or the limit of ``"auto"`` that did
@@ -128,7 +128,7 @@ class Model:
 
     @property
     def dynamics(self):
-        """What moves the parts (:mod:`meshwear.dynamics`): the mechanism, or
+        """What moves the parts (:mod:`meshwear.motion.dynamics`): the mechanism, or
         meshwear's own motions."""
         return self.mechanism if self.mechanism is not None else OWN_MOTIONS
 
@@ -204,14 +204,14 @@ class BodyState:
     #: (5, n) each vertex's total normal force (N), total squared normal
     #: force (N²) and total force vector along the normals (N, world) added
     #: up over the steps since they were last zeroed, kept while cycles are
-    #: jumped over (:data:`meshwear.jumps.LOAD_ROWS`); else (2, 0)
+    #: jumped over (:data:`meshwear.longrun.jumps.LOAD_ROWS`); else (2, 0)
     load: np.ndarray = field(default_factory=lambda: np.zeros((2, 0)))
     #: (1,) how much nearer (m) the body may come to a surface before its
     #: deepest vertex in contact has to be measured again against its
     #: ``depth_limit`` (docs/model.md, "Impacts"); 0: at the next step
     impact_room: np.ndarray = field(default_factory=lambda: np.zeros(1))
     #: the pairs' shares of the worn counter-surfaces' vertices, logged
-    #: over a measured cycle for implicit jumps (:func:`meshwear.jumps.pair_log`):
+    #: over a measured cycle for implicit jumps (:func:`meshwear.longrun.jumps.pair_log`):
     #: rows (surface, vertex, counter vertex) and the pair's normal force on
     #: the counter vertex (N), the rows used and whether to log (0 rows: not kept)
     log_index: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.int64))
@@ -219,7 +219,7 @@ class BodyState:
     log_count: np.ndarray = field(default_factory=lambda: np.zeros(2, np.int64))
     #: the step from which the log holds every pair (-1: none)
     log_from: int = -1
-    #: the half-space solve kept from step to step (:class:`meshwear.elastic.Patch`;
+    #: the half-space solve kept from step to step (:class:`meshwear.contact.elastic.Patch`;
     #: a cache, not saved in checkpoints), or None
     elastic: object = None
 
@@ -294,7 +294,7 @@ class PartState:
 class State:
     """Where a run is: ``step`` steps of ``dt`` represented (``time``), the
     bodies' state, the last step whose outputs are written, the cycle
-    jumping's bookkeeping (:class:`meshwear.wear.JumpState`, or None) and
+    jumping's bookkeeping (:class:`meshwear.longrun.wear.JumpState`, or None) and
     whether the state was reached by steps (``resolved``) or by a jump."""
 
     time: float

@@ -1,7 +1,7 @@
 """How the parts of a run move: the dynamics seam (docs/model.md, "Dynamics").
 
-The step loop (:mod:`meshwear.stepper`, its Python reference
-:func:`meshwear.simulate.step`, the cycle jumps, checkpoints and outputs)
+The step loop (:mod:`meshwear.step.stepper`, its Python reference
+:func:`meshwear.step.simulate.step`, the cycle jumps, checkpoints and outputs)
 moves the parts through one object, ``model.dynamics``, and does not care
 which it is. Two implement it:
 

@@ -2,7 +2,7 @@
 
 A motion owns one rule: given a body's pose at time ``t`` and the contact
 wrench on it, produce the pose at ``t + dt``. Contact never calls back into a
-motion, so the step order stays in :func:`meshwear.simulate.step`. Each is a
+motion, so the step order stays in :func:`meshwear.step.simulate.step`. Each is a
 kind and a parameter array of :mod:`meshwear.kernels.rigid`, so the compiled
 step loop (:mod:`meshwear.kernels.loop`) runs the same kernels.
 

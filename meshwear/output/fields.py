@@ -31,7 +31,7 @@ def body_quantities(body, s, model):
 
     The pressure of a vertex is its normal force over its contact area on
     each counter-surface, summed; with the half-space contact the solved
-    pressure at its point (:func:`meshwear.elastic.vertex_pressure`).
+    pressure at its point (:func:`meshwear.contact.elastic.vertex_pressure`).
 
     Returns
     -------

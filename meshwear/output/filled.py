@@ -78,7 +78,7 @@ def phases(model, start, stop, cycles):
 def record(model, state, start, stop, cycles, observers, progress, advance):
     """Resolve the cycle ``start..stop`` (writing its own outputs) by
     ``advance(model, state, stop, observers, progress)``
-    (:func:`meshwear.simulate.advance`), keeping the snapshots a jump of up
+    (:func:`meshwear.step.simulate.advance`), keeping the snapshots a jump of up
     to ``cycles`` cycles after it needs."""
     wanted = phases(model, start, stop, cycles)
     snapshots = {}
@@ -96,7 +96,7 @@ def write(model, state, stop, jump, snapshots, spans, observers, check, part_spa
     the jumped arrays at its start and end, and the shift of its position;
     ``part_spans`` the same per worn counter-part, in the order of
     ``state.parts``); ``check(model, state, face_normals)`` refuses an
-    invalid state (:func:`meshwear.simulate.check`). ``progress(f)``: per
+    invalid state (:func:`meshwear.step.simulate.check`). ``progress(f)``: per
     body, the share of each vertex's wear (n,) and of the move done at the
     fraction ``f`` of the jump's cycles (the implicit jump's own curve: the
     middle of a pin's scar slows as its edge comes into contact; None: ``f``

@@ -1,6 +1,6 @@
 """Recorders: observers that turn a running state into the files of docs/outputs.md.
 
-Physics never writes files; :func:`meshwear.simulate.run` calls
+Physics never writes files; :func:`meshwear.step.simulate.run` calls
 ``on_sample`` / ``on_frame`` and the CLI calls ``close`` with the summary.
 """
 

@@ -27,7 +27,7 @@ def wear_counters(model, body, s, t, pairs=None):
     taken at ``t`` (:func:`meshwear.kernels.counter_wear.wear_counter`).
     ``pairs``: per slot, the (contact state, normal force) the counter
     wears by, in place of the body's (the half-space model's: each vertex's
-    energy as a slip of its speed, :mod:`meshwear.elastic`). Returns None,
+    energy as a slip of its speed, :mod:`meshwear.contact.elastic`). Returns None,
     or ``(surface, vertex)``: a counter vertex that sank deeper than its
     mesh can follow in that step."""
     P = model.planes.shape[0]

@@ -35,7 +35,7 @@ JUMP_TRIAL, JUMP_TRIAL_LONGEST, BOUNDED_JUMPS = 3.0, 10.0, 8
 RETURNS = 20
 #: measurements the controller takes before its noise bounds let a first
 #: jump through (a vertex's scatter is fitted over three:
-#: :func:`meshwear.wear._counter_noise`)
+#: :func:`meshwear.longrun.jump_errors._counter_noise`)
 FIRST_JUMP_MEASUREMENTS = 3
 #: wall time (s) from the start of ``meshwear check`` (or of
 #: :func:`estimate_run`) by which the jump trial ends at the latest (in
@@ -143,7 +143,7 @@ def estimate_run(model, state=None, started=None):
 def _returns(model, state):
     """Seconds the run spends, beyond its steps, leaving the compiled loop
     for each output and every few thousand steps and checking the state at
-    each output (:func:`meshwear.simulate.advance`): :data:`RETURNS`
+    each output (:func:`meshwear.step.simulate.advance`): :data:`RETURNS`
     one-step spans timed against as many steps in one span just before them
     (not against the trial's mean step, which a run whose steps turn
     dearer, a body landing, would have booked as returns), and as many
@@ -226,7 +226,7 @@ def _trend_range(taken, longest):
     """``(fast, slow)``: the trends ``(a, b, c)``, jumps ``J = a (p / c)^b``
     at cycle ``p``, that bound the run's jumps after a trial that took
     ``taken`` (``longest``: its longest jump); ``fast`` None for jumps
-    growing by :data:`meshwear.wear.GROWTH` alone, ``slow`` None for no jump
+    growing by :data:`meshwear.longrun.wear.GROWTH` alone, ``slow`` None for no jump
     at all.
 
     What a bound other than growth allows moves with the depth worn and the
@@ -309,7 +309,7 @@ class _Jumped:
 
 def _resolved(js, step, n_c):
     """Cycles a trial that stopped at ``step`` resolved (``js``: its
-    :class:`meshwear.wear.JumpState`): the steps of the measurement it
+    :class:`meshwear.longrun.wear.JumpState`): the steps of the measurement it
     stopped in count too (stopped past it, at a jump: none)."""
     partial = step - js.cycle_start
     return (js.resolved_steps + (partial if 0 < partial < js.window * n_c else 0)) / n_c
@@ -318,7 +318,7 @@ def _resolved(js, step, n_c):
 def _per_cycle(elapsed, js, step, n_c):
     """Seconds of a resolved cycle, its jump's work included, from a trial
     of ``elapsed`` s that stopped at ``step`` (``js``: its
-    :class:`meshwear.wear.JumpState`): the steps of the cycle it stopped in
+    :class:`meshwear.longrun.wear.JumpState`): the steps of the cycle it stopped in
     count too, their time being in the trial's (not counting them made the
     gear pair's estimate 25 % high: a trial of 3 revolutions read as 2)."""
     return (elapsed - js.fill_seconds) / max(_resolved(js, step, n_c), 1.0)

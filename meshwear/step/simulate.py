@@ -7,7 +7,7 @@ active-set check, then contact -> normal force -> friction -> energy -> wear
 -> geometry update (one fused kernel, docs/model.md), then the body's motion
 from the contact wrench just computed (quasi-static: placed on its path and
 in load balance first). Runs take their steps in the compiled loop
-(:mod:`meshwear.stepper`), which runs the same kernels in the same order;
+(:mod:`meshwear.step.stepper`), which runs the same kernels in the same order;
 :func:`step` is its Python reference.
 """
 
@@ -124,7 +124,7 @@ def finish_step(model, body, s, t):
 def touch(model, body, s, t):
     """One step of the contact kernel at ``t``, the normal forces, their
     squares and vectors added to ``s.load`` if kept
-    (:data:`meshwear.jumps.LOAD_ROWS`), and the wear of worn counter-surfaces."""
+    (:data:`meshwear.longrun.jumps.LOAD_ROWS`), and the wear of worn counter-surfaces."""
     body_contact(model, body, s)
     if s.load.shape[1]:
         a = s.active
@@ -198,7 +198,7 @@ def run(model, state, observers=(), progress=None, checkpoint=None, compiled=Tru
         :func:`step` (the same numbers, slower; for tests).
     forced_jump : int, optional
         With cycle jumping, jump this many cycles each time instead of the
-        controller's choice (:func:`meshwear.wear.run_cycle_jump`).
+        controller's choice (:func:`meshwear.longrun.wear.run_cycle_jump`).
 
     Raises
     ------
@@ -222,7 +222,7 @@ def run(model, state, observers=(), progress=None, checkpoint=None, compiled=Tru
 def advance(model, state, stop, observers=(), progress=None, checkpoint=None, compiled=True):
     """Step ``state`` up to step ``stop``, writing every output due on the way
     (those of the current step first, unless already written); by the
-    compiled loop (:mod:`meshwear.stepper`), or step by step in Python."""
+    compiled loop (:mod:`meshwear.step.stepper`), or step by step in Python."""
     schedule = model.output_steps
     while True:
         if state.step > state.written:

@@ -3,11 +3,11 @@
 
 The loop runs whole spans of steps of one body inside numba. It returns to
 Python for an active-set refresh (python-fcl, numpy: done by the reference
-step :func:`meshwear.simulate.step_body`, or :func:`meshwear.simulate.finish_step`
+step :func:`meshwear.step.simulate.step_body`, or :func:`meshwear.step.simulate.finish_step`
 for the rest of a quasi-static step), for a load nothing can carry, and at the
 ``until`` step the caller asks for (outputs, checkpoints, progress). What
 moves the bodies between those is the model's dynamics
-(:mod:`meshwear.dynamics`): meshwear's own motions step each body's span
+(:mod:`meshwear.motion.dynamics`): meshwear's own motions step each body's span
 here, a MuJoCo mechanism steps them all with itself in its own compiled
 loop (:mod:`meshwear.mechanism`).
 """
@@ -20,13 +20,13 @@ from ..motion.packing import body_arrays as _body_arrays, motion_arrays as _moti
 
 def advance(model, state, until):
     """Step every body of ``state`` from ``state.step`` to step ``until``,
-    moved by the model's dynamics (:mod:`meshwear.dynamics`: meshwear's own
+    moved by the model's dynamics (:mod:`meshwear.motion.dynamics`: meshwear's own
     motions, or a MuJoCo mechanism)."""
     from ..motion.dynamics import UNSTABLE
     from .simulate import NumericalError, step
 
     if model.elastic is not None:
-        # the half-space solve is numpy's (meshwear.elastic): Python's steps
+        # the half-space solve is numpy's (meshwear.contact.elastic): Python's steps
         while state.step < until:
             step(model, state)
         return

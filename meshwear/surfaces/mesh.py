@@ -105,7 +105,7 @@ class MeshSurface(CounterSurface):
         #: and the face across each edge
         self.tree = None
         self.neighbours = tree.face_neighbours(self.faces)
-        #: what ``resolution`` did (:func:`meshwear.remesh.refine_part`), or None
+        #: what ``resolution`` did (:func:`meshwear.geometry.remesh.refine_part`), or None
         self.refinement = None
         #: a worn one's boxes' slack (m) and its wear depth when they were
         #: last fitted
@@ -155,7 +155,7 @@ class MeshSurface(CounterSurface):
 
     def refined(self, config, face_mask=None):
         """A :class:`MeshSurface` of this mesh refined to ``config.resolution``
-        where ``face_mask`` says (:func:`meshwear.remesh.refine_part`);
+        where ``face_mask`` says (:func:`meshwear.geometry.remesh.refine_part`);
         built before it wears.
 
         Raises
