@@ -8,7 +8,7 @@ import pytest
 
 import cases
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run, run_scene
 from meshwear.longrun.wear import GROWTH, THETA, _grows_from, choose_jump, error_estimate
 

@@ -33,7 +33,7 @@ from ..kernels.mechanism import (mechanism_loop, needs_refresh as _needs_refresh
                                  place_surface, push_body, push_reaction,
                                  slot_wrench as _slot_wrench)
 from ..motion.packing import body_arrays, motion_arrays
-from ..scene.format import SceneError
+from ..scene.checks import SceneError
 from ..contact.stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_stiffness
 from ..surfaces.base import quaternion_matrix
 

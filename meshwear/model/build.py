@@ -25,7 +25,7 @@ from ..kernels.laws import code_of
 from ..kernels.nearest import face_frames
 from ..motion.motions import (BalancedMotion, FixedMotion, FreeMotion, GuidedMotion,
                               MechanismMotion, Path, TurningMotion, PrescribedMotion)
-from ..scene.format import SceneError
+from ..scene.checks import SceneError
 from ..contact.stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_stiffness
 
 #: meshwear's own motions, the dynamics of a model without a mechanism
