@@ -33,7 +33,7 @@ import numpy as np  # noqa: E402
 from scipy.optimize import brentq  # noqa: E402
 
 from common import replace_section, timed_run  # noqa: E402
-from meshwear.scene.format import load_scene  # noqa: E402
+from meshwear.scene.reader import load_scene  # noqa: E402
 from meshwear.longrun.jump_errors import error_estimate  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -23,7 +23,7 @@ import numpy as np  # noqa: E402
 
 from common import timed_run, write_measured  # noqa: E402
 from meshwear.kernels.contact import rotation_entries  # noqa: E402
-from meshwear.scene.format import load_scene  # noqa: E402
+from meshwear.scene.reader import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "cylinder_on_worn_flat.toml"

@@ -34,7 +34,7 @@ from common import write_measured  # noqa: E402
 from meshwear.step import stepper  # noqa: E402
 from meshwear.contact.halfspace import contact_modulus  # noqa: E402
 from meshwear.model.build import build_model, initial_state  # noqa: E402
-from meshwear.scene.format import parse_scene  # noqa: E402
+from meshwear.scene.reader import parse_scene
 
 E, NU, R, LOAD, MU = 210e9, 0.3, 0.005, 10.0, 0.5
 E_STAR = contact_modulus((E, E), (NU, NU))

@@ -30,7 +30,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from common import timed_run, write_measured  # noqa: E402
-from meshwear.scene.format import load_scene  # noqa: E402
+from meshwear.scene.reader import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "gear_pair.toml"

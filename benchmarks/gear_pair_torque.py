@@ -43,7 +43,7 @@ from gear_pair import ALPHA, MODULE, PITCH, TEETH  # noqa: E402
 from meshwear import cli  # noqa: E402
 from meshwear.model.build import build_model, initial_state  # noqa: E402
 from meshwear.output.export import read_frame, series_frames  # noqa: E402
-from meshwear.scene.format import load_scene  # noqa: E402
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -37,7 +37,7 @@ from gear_pair import ALPHA, PITCH, TEETH  # noqa: E402
 from gear_pair_torque import flank_profile, last_depths, tooth_and_side  # noqa: E402
 from meshwear import cli  # noqa: E402
 from meshwear.model.build import build_model, initial_state  # noqa: E402
-from meshwear.scene.format import load_scene  # noqa: E402
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run  # noqa: E402
 from meshwear.surfaces import quaternion_matrix  # noqa: E402
 

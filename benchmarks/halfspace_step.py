@@ -33,7 +33,7 @@ import numpy as np
 from meshwear.step import stepper
 from meshwear.contact.halfspace import contact_modulus
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import parse_scene
+from meshwear.scene.reader import parse_scene
 
 E_BALL, E_FLAT, NU, R, LOAD, MU = 3e9, 210e9, 0.35, 0.01, 10.0, 0.4
 

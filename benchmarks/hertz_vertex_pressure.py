@@ -45,7 +45,7 @@ from cases import cell_radii, ellipse_radius  # noqa: E402
 from meshwear.contact.halfspace import contact_modulus  # noqa: E402
 from meshwear.model.build import build_model, initial_state  # noqa: E402
 from meshwear.output.fields import body_quantities  # noqa: E402
-from meshwear.scene.format import parse_scene  # noqa: E402
+from meshwear.scene.reader import parse_scene
 
 VALIDATION = ROOT / "examples" / "validation" / "hertz_ball.toml"
 FIGURE = ROOT / "docs" / "img" / "hertz_vertex_pressure.png"

@@ -25,7 +25,7 @@ from pathlib import Path
 
 from meshwear.longrun import wear
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -29,7 +29,7 @@ from numba import njit
 
 from meshwear.kernels import loop
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run
 from meshwear.step import stepper
 from meshwear.step.stepper import _body_arrays, _motion_arrays

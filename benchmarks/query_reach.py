@@ -24,7 +24,7 @@ from pathlib import Path
 
 from meshwear.step import stepper
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.surfaces import active
 
 ROOT = Path(__file__).resolve().parents[1]

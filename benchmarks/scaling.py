@@ -37,7 +37,7 @@ import trimesh
 from common import replace_section
 from meshwear.step import stepper
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 MARK_START, MARK_END = "<!-- scaling:start -->", "<!-- scaling:end -->"

@@ -34,7 +34,7 @@ from meshwear import cli  # noqa: E402
 from meshwear.model.build import build_model, initial_state  # noqa: E402
 from meshwear.output.export import part_mesh, read_frame, series_frames  # noqa: E402
 from meshwear.output.memory import MemoryHistory  # noqa: E402
-from meshwear.scene.format import load_scene  # noqa: E402
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -29,7 +29,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 import cases  # noqa: E402  (cap_depth)
 
 from common import replace_section  # noqa: E402
-from meshwear.scene.format import load_scene  # noqa: E402
+from meshwear.scene.reader import load_scene  # noqa: E402
 from meshwear.model.build import build_model, initial_state  # noqa: E402
 from meshwear.step.simulate import run  # noqa: E402
 from meshwear.longrun.jump_errors import error_estimate  # noqa: E402

@@ -28,7 +28,7 @@ from common import write_measured  # noqa: E402
 from meshwear import cli  # noqa: E402
 from meshwear.contact.halfspace import contact_modulus  # noqa: E402
 from meshwear.output.export import read_frame, series_frames  # noqa: E402
-from meshwear.scene.format import load_scene  # noqa: E402
+from meshwear.scene.reader import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT / "examples" / "sphere_on_flat_fretting_elastic.toml"

@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from .geometry.remesh import available_memory
-from .scene.format import Scene, SceneError, load_scene
+from .scene.reader import Scene, load_scene
+from .scene.checks import SceneError
 
 
 def load(path, values=None):
@@ -47,7 +48,7 @@ def load(path, values=None):
         One line naming the file and the key.
     """
     pairs = list(values.items()) if isinstance(values, dict) else list(values or ())
-    from .scene.format import _plain
+    from .scene.reader import _plain
 
     return load_scene(path, [(k, _plain(v)) for k, v in pairs])
 

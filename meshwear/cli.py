@@ -142,7 +142,7 @@ def exit_path(command):
 
     from .geometry.meshes import MeshError
     from .output.export import ExportError
-    from .scene.format import SceneError
+    from .scene.checks import SceneError
     from .step.simulate import NumericalError
 
     global _notices
@@ -222,14 +222,14 @@ def _set_option(parser):
 
 
 def _overrides(texts):
-    from .scene.format import parse_override
+    from .scene.reader import parse_override
 
     return tuple(parse_override(text) for text in texts)
 
 
 def _prepare(scene_path, overrides=()):
     from .model.build import build_model, check_time_step
-    from .scene.format import load_scene
+    from .scene.reader import load_scene
 
     scene = load_scene(scene_path, overrides)
     model = build_model(scene)

@@ -21,7 +21,8 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from .scene.format import SceneError, parse_override
+from .scene.reader import parse_override
+from .scene.checks import SceneError
 
 #: modes of combining the varied values
 MODES = ("grid", "list")

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from meshwear.kernels.contact import rotation_entries
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run_scene
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

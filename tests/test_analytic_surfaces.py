@@ -15,7 +15,8 @@ import reference
 from meshwear import geometry
 from meshwear.kernels import analytic, frames
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import RotationConfig, load_scene
+from meshwear.scene.reader import load_scene
+from meshwear.scene.parts import RotationConfig
 from meshwear.step.simulate import run_scene, step
 from meshwear.surfaces import MeshSurface
 
@@ -340,7 +341,7 @@ def test_a_cylinder_shape_turning_about_its_axis_deviates_by_its_facets_sag():
     O(sections²), 5-9 s for 10 000). Off its axis it is sampled as before."""
     import time
 
-    from meshwear.scene.format import ShapeConfig
+    from meshwear.scene.parts import ShapeConfig
 
     def shaped(sections, **kwargs):
         ring = _ring(sections, **kwargs)

@@ -13,7 +13,8 @@ import trimesh
 import meshwear
 from meshwear.cli import main
 from meshwear.kernels.contact import rotation_entries
-from meshwear.scene.format import SceneError, load_scene
+from meshwear.scene.reader import load_scene
+from meshwear.scene.checks import SceneError
 from test_counter_wear import PIN_ON_WORN_DISC
 
 #: a tenth of a turn of the pin on a worn disc: both parts wear

@@ -12,7 +12,8 @@ import pytest
 from meshwear.cli import main
 from meshwear.model.build import build_model, check_time_step
 from meshwear.model.timestep import AUTO_STEPS_PER_CYCLE, AUTO_STEPS_PER_RUN, stable_time_step
-from meshwear.scene.format import SceneError, load_scene
+from meshwear.scene.checks import SceneError
+from meshwear.scene.reader import load_scene
 
 # the minimal scene: a steel block dropped on a floor, nothing but
 # what it needs (stiffness 1e9 N/m per vertex: the default 1e-5 s was unstable)

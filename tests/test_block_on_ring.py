@@ -12,7 +12,7 @@ import pytest
 from scipy.optimize import brentq
 
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

@@ -13,7 +13,8 @@ import trimesh
 
 from meshwear.cli import main
 from meshwear.geometry.meshes import CAD_EXTRA, MeshError, load_mesh
-from meshwear.scene.format import SceneError, load_scene
+from meshwear.scene.reader import load_scene
+from meshwear.scene.checks import SceneError
 
 ROOT = Path(__file__).resolve().parents[1]
 STEP = ROOT / "meshes" / "pin_d6_h10_mm.step"

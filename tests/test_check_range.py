@@ -15,7 +15,7 @@ from meshwear.step import estimate
 from meshwear.cli import main
 from meshwear.step.estimate import _cycles_left, _forecast, _jump_at, _trend_range
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run
 from meshwear.longrun.jump_choice import GROWTH
 

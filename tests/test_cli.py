@@ -684,7 +684,7 @@ def test_installed_command_refuses_a_bad_scene(tmp_path):
 
 def test_progress_is_reported_between_sparse_samples(tmp_path):
     from meshwear.model.build import build_model, initial_state
-    from meshwear.scene.format import load_scene
+    from meshwear.scene.reader import load_scene
     from meshwear.step.simulate import PROGRESS_STEPS, run
 
     scene = write(tmp_path / "scene.toml", BASE.replace("history = 5", "history = 2").replace(

@@ -17,7 +17,8 @@ from meshwear.cli import main
 from meshwear.kernels import counter_wear
 from meshwear.kernels.counter_wear import settle_counter, wear_counter
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import SceneError, load_scene
+from meshwear.scene.reader import load_scene
+from meshwear.scene.checks import SceneError
 from meshwear.step.simulate import NumericalError, run
 
 #: a flat pin (radius a = 1 mm) held R = 5 mm off the axis of a disc turning

@@ -8,7 +8,7 @@ import pytest
 
 import cases
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run, run_scene
 from meshwear.longrun.jump_choice import GROWTH, THETA, choose_jump
 from meshwear.longrun.jump_errors import error_estimate

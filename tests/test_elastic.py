@@ -10,7 +10,8 @@ import pytest
 from meshwear.contact.halfspace import contact_modulus
 from meshwear.kernels.contact import STICK
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import SceneError, load_scene
+from meshwear.scene.reader import load_scene
+from meshwear.scene.checks import SceneError
 from meshwear.step.simulate import NumericalError, step
 
 from cases import cell_radii, ellipse_radius

@@ -28,7 +28,7 @@ from cases import EXAMPLES
 from meshwear.cli import main
 from meshwear.output import maps, plots
 from meshwear.output.export import worn_parts
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 
 TURN = 2.0 * np.pi / 10.0          # s: a turn at the examples' 10 rad/s
 

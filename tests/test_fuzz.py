@@ -69,7 +69,7 @@ def test_overflowing_and_zero_vectors(key, value):
 
 def test_an_overflowing_direction_is_normalised_not_zeroed():
     # [1.7e308]*3 used to normalise to zero: the load was ignored and the block floated
-    from meshwear.scene.format import load_scene
+    from meshwear.scene.reader import load_scene
 
     scene = load_scene(EXAMPLES / "pin_on_disc.toml", (("body[0].path.free_axis", [0.0, 0.0, HUGE]),))
     assert scene.bodies[0].path.free_axis == (0.0, 0.0, 1.0)

@@ -146,7 +146,7 @@ def test_a_mesh_file_is_read_once_per_model(monkeypatch):
     """The gear pair's two gears are one file, and a refined body's mesh is
     read for the checks before refining too: each read once per build."""
     from meshwear.model.build import build_model
-    from meshwear.scene.format import load_scene
+    from meshwear.scene.reader import load_scene
 
     reads = []
     load = meshes.load_mesh
@@ -457,7 +457,7 @@ def test_a_ball_is_refined_within_its_resolution_reach_not_over_its_coarse_faces
     faces a millimetre wide under the ball were refined to 123 um above the
     plane: 50 172 vertices where 11 730 do.)"""
     from meshwear.model.build import build_model
-    from meshwear.scene.format import load_scene
+    from meshwear.scene.reader import load_scene
 
     path = tmp_path / "ball.toml"
     path.write_text(BALL_ON_A_PLANE)
@@ -484,7 +484,7 @@ def test_refined_primitives_put_their_vertices_on_the_exact_surface():
     towards the axis by up to R (1 - cos(pi / sections)): 0.45 um for R = 6 mm
     and 256 sections); the caps stay flat; the facets then sag at most
     SAG_FRACTION of the resolution where refined."""
-    from meshwear.scene.format import ShapeConfig
+    from meshwear.scene.parts import ShapeConfig
 
     class Part:
         def __init__(self, shape, resolution):

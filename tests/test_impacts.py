@@ -14,7 +14,7 @@ from meshwear.cli import main
 from meshwear.kernels.frames import step_motion
 from meshwear.kernels.loop import deepest_penetration, impact_check, use_impact_room
 from meshwear.model.build import IMPACT_DEPTH, build_model, initial_state
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import NumericalError, run
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -8,7 +8,7 @@ import cases
 from meshwear import geometry
 from meshwear.longrun import jump_geometry, wear
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import inverted, run
 
 #: a 10 mm ball fretting +-0.1 mm under 50 N on a plane, archard, cycle jumping

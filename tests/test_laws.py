@@ -7,7 +7,8 @@ import pytest
 from numba import njit
 
 from meshwear.kernels import laws
-from meshwear.scene.format import SceneError, WearConfig
+from meshwear.scene.settings import WearConfig
+from meshwear.scene.checks import SceneError
 
 
 @njit(cache=True)

@@ -16,7 +16,7 @@ from meshwear import api
 from meshwear.geometry import remesh
 from meshwear.cli import main
 from meshwear.output import recorder
-from meshwear.scene.format import SceneError
+from meshwear.scene.checks import SceneError
 
 ROOT = Path(__file__).resolve().parents[1]
 POD = str(ROOT / "examples" / "pin_on_disc.toml")

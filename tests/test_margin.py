@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from meshwear.model.build import build_model
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.surfaces.margin import APPROACHES, _approach
 
 #: the Winkler modulus (N/m³), the load (N) and Archard's coefficient (1/Pa)

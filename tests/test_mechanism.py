@@ -16,7 +16,8 @@ from meshwear.cli import main
 from meshwear.mechanism.coupling import slot_wrench
 from meshwear.model.build import build_model, check_time_step, initial_state
 from meshwear.output.memory import MemoryHistory
-from meshwear.scene.format import SceneError, load_scene
+from meshwear.scene.reader import load_scene
+from meshwear.scene.checks import SceneError
 from meshwear.step.simulate import run
 from test_resume import _KillAt, _Stop
 

@@ -12,7 +12,7 @@ import trimesh
 
 import reference
 from meshwear.kernels import nearest
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run_scene
 
 RTOL = 1e-12
@@ -481,13 +481,13 @@ def test_an_open_sheet_counter_mesh_works_and_a_wrongly_wound_one_is_refused(tmp
     _, state, sheet = _run(tmp_path, text.replace("MESH", "up.stl"), "up")
     assert sheet.rows["block"]["friction_work"][-1] == pytest.approx(
         plane.rows["block"]["friction_work"][-1], rel=1e-9)
-    from meshwear.scene.format import SceneError
+    from meshwear.scene.checks import SceneError
     with pytest.raises(SceneError, match=r"body\[0\].position.*inside surface 'floor'"):
         _run(tmp_path, text.replace("MESH", "down.stl"), "down")
 
 
 def test_a_degenerate_counter_mesh_is_refused_naming_the_key(tmp_path):
-    from meshwear.scene.format import SceneError
+    from meshwear.scene.checks import SceneError
 
     line = np.array([[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.02, 0.0, 0.0]])
     path = tmp_path / "flat.obj"

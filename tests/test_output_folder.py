@@ -13,7 +13,7 @@ from meshwear.longrun import checkpoint
 from meshwear.cli import main
 from meshwear.model.build import build_model, initial_state
 from meshwear.output.recorder import RunRecorder
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import advance
 
 ROOT = Path(__file__).resolve().parents[1]

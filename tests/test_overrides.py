@@ -9,7 +9,8 @@ import pytest
 from meshwear.longrun import checkpoint
 from meshwear.cli import main
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import SceneError, load_scene, parse_override, set_key
+from meshwear.scene.reader import load_scene, parse_override, set_key
+from meshwear.scene.checks import SceneError
 
 ROOT = Path(__file__).resolve().parents[1]
 POD = str(ROOT / "examples" / "pin_on_disc.toml")

@@ -13,7 +13,8 @@ from reference import FACING, contact_areas, point_coefficients
 from meshwear.kernels.contact import rotation_entries
 from meshwear.model.build import build_model
 from meshwear.model.timestep import stable_time_step
-from meshwear.scene.format import SceneError, load_scene
+from meshwear.scene.checks import SceneError
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run_scene
 
 G = 9.81

@@ -8,7 +8,7 @@ import pytest
 import cases
 from meshwear.model.build import build_model, initial_state
 from meshwear.model.timestep import stable_time_step
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run_scene
 
 

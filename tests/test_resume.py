@@ -18,7 +18,7 @@ import cases
 from meshwear.longrun import checkpoint
 from meshwear.cli import main
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -8,9 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from meshwear.scene.format import (BodyConfig, Circle, ContactConfig, Oscillation, PathConfig,
-                                   RotationConfig, RunConfig, Scene, SceneError, ShapeConfig,
-                                   SurfaceConfig, WearConfig, load_scene, parse_scene)
+from meshwear.scene.reader import Scene, load_scene, parse_scene
+from meshwear.scene.parts import (BodyConfig, Circle, Oscillation, PathConfig, RotationConfig,
+                                  ShapeConfig, SurfaceConfig)
+from meshwear.scene.settings import ContactConfig, RunConfig, WearConfig
+from meshwear.scene.checks import SceneError
 
 FULL = """
 format = 1

@@ -10,7 +10,7 @@ import pytest
 
 from meshwear.longrun.jumps import LOAD_ROWS
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import load_scene
+from meshwear.scene.reader import load_scene
 from meshwear.step.simulate import run
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

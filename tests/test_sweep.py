@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from meshwear.cli import main
-from meshwear.scene.format import SceneError
+from meshwear.scene.checks import SceneError
 from meshwear.sweep import from_arguments, run_sweep
 from test_counter_wear import PIN_ON_WORN_DISC
 

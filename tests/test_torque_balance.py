@@ -18,7 +18,8 @@ from meshwear.kernels.contact import FACING, all_vertices, rotation_entries
 from meshwear.kernels.rigid import TURNING
 from meshwear.kernels.turn_balance import balance_angle
 from meshwear.model.build import build_model, initial_state
-from meshwear.scene.format import SceneError, load_scene
+from meshwear.scene.reader import load_scene
+from meshwear.scene.checks import SceneError
 from meshwear.step.simulate import run, run_scene
 
 from cases import EXAMPLES

@@ -27,7 +27,7 @@ def test_fretting_example_sticks_inside_the_partial_slip_radius(measured):
     import numpy as np
 
     from meshwear.kernels.contact import rotation_entries
-    from meshwear.scene.format import load_scene
+    from meshwear.scene.reader import load_scene
     from meshwear.step.simulate import run_scene
 
     scene = load_scene(cases.EXAMPLES / "sphere_on_flat_fretting.toml")

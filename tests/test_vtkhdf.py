@@ -18,7 +18,8 @@ from meshwear.longrun import checkpoint
 from meshwear.cli import main
 from meshwear.output.export import part_mesh, series_frames
 from meshwear.output.vtkhdf import VTKHDFSeries, read_frames
-from meshwear.scene.format import SceneError, load_scene
+from meshwear.scene.reader import load_scene
+from meshwear.scene.checks import SceneError
 from test_resume import _block_scene, _meshwear, _rows
 
 FACES = np.array([[0, 1, 2], [0, 2, 3], [1, 3, 2]])

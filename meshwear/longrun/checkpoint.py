@@ -19,7 +19,7 @@ import numpy as np
 
 from ..kernels.rigid import SETTLED, TURNING
 from ..output.tables import replace_atomic
-from ..scene.format import SceneError
+from ..scene.checks import SceneError
 
 FILE_NAME = "checkpoint.npz"
 _BODY_ARRAYS = ("pose", "vertices", "wear_depth", "friction_work", "wear_volume",

@@ -39,7 +39,7 @@ import logging
 import numpy as np
 
 from ..kernels.mechanism import place_body, place_surface
-from ..scene.format import SceneError
+from ..scene.checks import SceneError
 from ..surfaces.base import quaternion_matrix
 from .active_sets import TRIAL_STEPS, ActiveSets
 from .coupling import Coupling

@@ -30,7 +30,7 @@ from ..kernels.contact import LAW_SLOTS, all_vertices, make_law, rotation_entrie
 from ..kernels.laws import code_of
 from ..motion.motions import (BalancedMotion, FixedMotion, FreeMotion, GuidedMotion,
                               MechanismMotion, Path, TurningMotion, PrescribedMotion)
-from ..scene.format import SceneError
+from ..scene.checks import SceneError
 from .state import BodyModel, BodyState, Model, PartState, State
 from .timestep import _even_steps, _stable_limit, _timing, auto_time_step_why, stable_time_step
 

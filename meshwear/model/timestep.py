@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from ..motion.motions import MechanismMotion
-from ..scene.format import SceneError
+from ..scene.checks import SceneError
 from ..contact.stability import STABILITY_MARGIN, contact_matrix, stable_step, vertex_stiffness
 
 #: ``run.dt = "auto"`` resolves a cycle of the motion into at least this many steps

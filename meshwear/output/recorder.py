@@ -8,7 +8,7 @@ import errno
 import shutil
 from pathlib import Path
 
-from ..scene.format import RESERVED_NAMES
+from ..scene.reader import RESERVED_NAMES
 from .fields import body_quantities, body_totals, part_quantities
 from .export import SERIES_SUFFIXES
 from .folder import SPARE_BYTES, FolderLock, check_writable

@@ -313,7 +313,7 @@ def run_scene(scene, observers=(), check_dt=True):
     model, state, history : Model, State, MemoryHistory
     """
     from ..model.build import build_model, check_time_step, initial_state
-    from ..scene.format import Scene, load_scene
+    from ..scene.reader import Scene, load_scene
 
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
