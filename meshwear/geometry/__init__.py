@@ -1,4 +1,4 @@
-"""Geometry: meshes in, plain arrays out (stage 1 of docs/index.md's code map).
+"""Geometry: meshes in, plain arrays out (docs/index.md, "Code map").
 
 - :mod:`.meshes`: loading, units, cleaning, primitives, face normals;
 - :mod:`.properties`: vertex areas and normals, inverted faces, mass properties;

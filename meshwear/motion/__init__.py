@@ -1,8 +1,9 @@
-"""How bodies move (docs/model.md, "Motion"): paths, the free, guided, balanced, turning,
-prescribed and fixed motions, and the dynamics seam every way of moving fills.
+"""How bodies move (docs/model.md, "Rigid-body motion"): paths, the free,
+guided, balanced, turning, prescribed and fixed motions, and the dynamics seam
+every way of moving fills.
 
 - :mod:`.motions`: paths and the motions of meshwear's own bodies;
-- :mod:`.dynamics`: the seam (:class:`~.dynamics.Dynamics`) and meshwear's own motions behind it;
+- :mod:`.dynamics`: the seam every way of moving fills, and meshwear's own motions behind it;
 - :mod:`.packing`: a body and its motion as the compiled step loops take them.
 
 Imports only :mod:`meshwear.kernels` (the MuJoCo mechanism, which also moves

@@ -1,4 +1,4 @@
-"""The step and the run's loop (docs/model.md, "Time stepping").
+"""The step and the run's loop (docs/model.md, "The step loop").
 
 - :mod:`.simulate`: :func:`~.simulate.run` drives the steps and calls the
   observers; :func:`~.simulate.step_body` fixes the phase order of one step;
