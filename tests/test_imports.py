@@ -186,7 +186,8 @@ def _code_map():
 
 
 def test_the_code_map_names_every_module_and_no_other():
-    on_disk = {str(p.relative_to(PACKAGE)) for p in PACKAGE.rglob("*.py") if p.name != "__init__.py"}
+    on_disk = {str(p.relative_to(PACKAGE)) for p in PACKAGE.rglob("*.py")
+               if p.name != "__init__.py"}
     named = _code_map()
     assert named == on_disk, (f"not in docs/index.md's code map: {sorted(on_disk - named)}; "
                               f"named there but no such file: {sorted(named - on_disk)}")
