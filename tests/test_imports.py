@@ -106,6 +106,12 @@ def test_a_stage_imports_only_its_own_and_the_stages_below():
     assert not wrong, "\n".join(wrong)
 
 
+def _python(code):
+    """``code`` run in a fresh interpreter (nothing of meshwear imported yet)."""
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=120, cwd=ROOT)
+
+
 def test_the_old_module_paths_warn_and_give_the_new_modules():
     code = ("import warnings, importlib; warnings.simplefilter('error');\n"
             "from meshwear._moved import MOVED\n"
@@ -122,8 +128,7 @@ def test_the_old_module_paths_warn_and_give_the_new_modules():
             "    assert m is importlib.import_module(new) and m.__spec__.name == new, old\n"
             "import meshwear.simulate as s, meshwear.step.simulate as t; assert s is t\n"
             "from meshwear import wear; assert wear.__name__ == 'meshwear.longrun.wear'\n")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          timeout=120, cwd=ROOT)
+    done = _python(code)
     assert done.returncode == 0, done.stderr.strip()[-500:]
 
 
@@ -154,16 +159,14 @@ def test_the_names_that_left_the_model_warn_and_give_the_new_ones():
             "    assert name not in model.__all__, name\n"
             "from meshwear.model import settle_counters, body_contact\n"
             "assert not hasattr(model, 'no_such_name')\n")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          timeout=120, cwd=ROOT)
+    done = _python(code)
     assert done.returncode == 0, done.stderr.strip()[-500:]
 
 
 def test_the_modules_that_were_in_cycles_import_first():
     for name in ("meshwear.geometry.remesh", "meshwear.longrun.wear", "meshwear.output.filled",
                  "meshwear.longrun.jumps", "meshwear.step.simulate", "meshwear.model"):
-        done = subprocess.run([sys.executable, "-c", f"import {name}"], capture_output=True,
-                              text=True, timeout=120, cwd=ROOT)
+        done = _python(f"import {name}")
         assert done.returncode == 0, f"import {name} first: {done.stderr.strip()[-300:]}"
 
 

@@ -10,15 +10,13 @@ resumed ends with the same numbers as one that was never interrupted.
 """
 
 import hashlib
-import os
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
 from ..kernels.rigid import SETTLED, TURNING
-from ..output.tables import replace_atomic
+from ..output.tables import write_atomic
 from ..scene.checks import SceneError
 
 FILE_NAME = "checkpoint.npz"
@@ -142,18 +140,7 @@ def save(path, model, state, wall_time):
                 arrays[f"jump_history{h}_alpha{k}"] = alpha
             for k, rate in enumerate(part_rates):
                 arrays[f"jump_history{h}_part{k}"] = rate
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            np.savez(f, **arrays)
-        replace_atomic(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    write_atomic(path, lambda f: np.savez(f, **arrays), binary=True)
 
 
 def load(path, model, state):

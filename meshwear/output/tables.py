@@ -127,15 +127,22 @@ def replace_atomic(tmp, path):
 
 
 def write_text_atomic(path, text):
-    """Replace ``path`` by ``text`` atomically (temporary file in the same directory).
+    """Replace ``path`` by ``text`` atomically (:func:`write_atomic`)."""
+    write_atomic(path, lambda f: f.write(text))
 
-    A reader, or a run killed mid-write, sees the old file or the new one, never a part.
+
+def write_atomic(path, write, binary=False):
+    """Replace ``path`` by what ``write(f)`` writes to an open file ``f``
+    (text, UTF-8 with ``\\n`` line ends, or ``binary``), atomically: through
+    a temporary file in the same directory. A reader, or a run killed
+    mid-write, sees the old file or the new one, never a part.
     """
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-            f.write(text)
+        with (os.fdopen(fd, "wb") if binary
+              else os.fdopen(fd, "w", encoding="utf-8", newline="\n")) as f:
+            write(f)
         replace_atomic(tmp, path)
     except BaseException:
         try:
